@@ -1,0 +1,174 @@
+// ParticleSet<Real>: the particles of one simulation as a structure of arrays.
+//
+// Layout (the thesis's Figure 4.1, one array per component instead of padded
+// xyz quadruples, so loops vectorise over particles): every field is an
+// AlignedVector whose storage starts on a 64-byte boundary.
+//
+// Invariants:
+//  - every field, built-in or extra, has exactly size() elements per component;
+//    change the count only through resize() and the order only through reorder();
+//  - id[i] is the particle's stable identity: it is set once at creation and
+//    travels with the particle through every reorder().
+//
+// Units follow the solver: SI (m, m/s, m/s², kg, kg/m³, Pa) for SPH; G = 1
+// N-body units for gravity.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "swirl/core/aligned.hpp"
+#include "swirl/core/vec3.hpp"
+
+namespace swirl {
+
+// Three component arrays of one vector field.
+template <class Real>
+struct Vec3Array {
+  AlignedVector<Real> x, y, z;
+
+  AlignedVector<Real>& operator[](int axis) { return axis == 0 ? x : (axis == 1 ? y : z); }
+  const AlignedVector<Real>& operator[](int axis) const { return axis == 0 ? x : (axis == 1 ? y : z); }
+  Vec3<Real> get(std::size_t i) const { return {x[i], y[i], z[i]}; }
+  void set(std::size_t i, const Vec3<Real>& v) { x[i] = v.x; y[i] = v.y; z[i] = v.z; }
+};
+
+// A named view of one field: 1 component (scalar) or 3 (vector). The name is
+// the array name written to output files and what ParaView shows.
+template <class T>
+struct FieldView {
+  std::string_view name;
+  int components = 1;
+  std::array<T*, 3> data{};  // data[c] for c < components
+};
+
+template <class Real>
+class ParticleSet {
+ public:
+  using value_type = Real;
+
+  ParticleSet() = default;
+  explicit ParticleSet(std::size_t n) { resize(n); }
+
+  std::size_t size() const { return mass.size(); }
+  bool empty() const { return size() == 0; }
+
+  // Changes the particle count of every field; new entries are zero.
+  void resize(std::size_t n) {
+    for (auto* v : {&position, &velocity, &acceleration, &acceleration_prev}) {
+      v->x.resize(n); v->y.resize(n); v->z.resize(n);
+    }
+    mass.resize(n); density.resize(n); pressure.resize(n); id.resize(n);
+    for (auto& f : extra_) for (int c = 0; c < f.components; ++c) f.data[c].resize(n);
+  }
+
+  // Adds a solver-specific field (zero-filled) and returns its index; if a field
+  // of that name and shape exists already, returns its index.
+  std::size_t add_field(std::string name, int components) {
+    if (components != 1 && components != 3) throw std::invalid_argument("a field has 1 or 3 components");
+    for (std::size_t k = 0; k < extra_.size(); ++k) {
+      if (extra_[k].name == name) {
+        if (extra_[k].components != components) throw std::invalid_argument("field '" + name + "' exists with another shape");
+        return k;
+      }
+    }
+    if (is_builtin_name(name)) throw std::invalid_argument("field '" + name + "' is a built-in field");
+    ExtraField f{std::move(name), components, {}};
+    for (int c = 0; c < components; ++c) f.data[c].assign(size(), Real(0));
+    extra_.push_back(std::move(f));
+    return extra_.size() - 1;
+  }
+  // Component c of extra field k (as returned by add_field).
+  AlignedVector<Real>& extra(std::size_t k, int c = 0) { return extra_.at(k).data.at(c); }
+  const AlignedVector<Real>& extra(std::size_t k, int c = 0) const { return extra_.at(k).data.at(c); }
+  std::size_t extra_count() const { return extra_.size(); }
+
+  // Permutes every field so that the particle at old index perm[i] moves to
+  // index i (a gather). perm must be a permutation of 0..size()-1.
+  void reorder(std::span<const std::size_t> perm) {
+    check_permutation(perm);
+    AlignedVector<Real> scratch(size());
+    auto gather = [&](AlignedVector<Real>& a) {
+      for (std::size_t i = 0; i < perm.size(); ++i) scratch[i] = a[perm[i]];
+      a.swap(scratch);
+    };
+    for (auto* v : {&position, &velocity, &acceleration, &acceleration_prev}) {
+      gather(v->x); gather(v->y); gather(v->z);
+    }
+    gather(mass); gather(density); gather(pressure);
+    for (auto& f : extra_) for (int c = 0; c < f.components; ++c) gather(f.data[c]);
+    AlignedVector<std::uint64_t> ids(size());
+    for (std::size_t i = 0; i < perm.size(); ++i) ids[i] = id[perm[i]];
+    id.swap(ids);
+  }
+
+  // Every real-valued field (position first, then the other built-ins, then the
+  // extra fields in creation order): what writers and checkpoints iterate over.
+  // The id array is not real-valued and is reached directly.
+  std::vector<FieldView<const Real>> fields() const { return fields_impl<const Real>(*this); }
+  std::vector<FieldView<Real>> fields() { return fields_impl<Real>(*this); }
+
+  // Built-in fields (see the units note above).
+  Vec3Array<Real> position;           // x
+  Vec3Array<Real> velocity;           // v
+  Vec3Array<Real> acceleration;       // a at the current positions
+  Vec3Array<Real> acceleration_prev;  // a of the previous step (velocity Verlet)
+  AlignedVector<Real> mass;           // m, constant in time
+  AlignedVector<Real> density;        // ρ (SPH)
+  AlignedVector<Real> pressure;       // p (SPH)
+  AlignedVector<std::uint64_t> id;    // stable identity, survives reorder()
+
+ private:
+  struct ExtraField {
+    std::string name;
+    int components = 1;
+    std::array<AlignedVector<Real>, 3> data;
+  };
+
+  static bool is_builtin_name(std::string_view n) {
+    for (auto b : {"position", "velocity", "acceleration", "acceleration_prev", "mass", "density", "pressure", "id"})
+      if (n == b) return true;
+    return false;
+  }
+
+  void check_permutation(std::span<const std::size_t> perm) const {
+    if (perm.size() != size()) throw std::invalid_argument("reorder: permutation has the wrong length");
+    std::vector<bool> seen(perm.size(), false);
+    for (std::size_t p : perm) {
+      if (p >= perm.size() || seen[p]) throw std::invalid_argument("reorder: not a permutation");
+      seen[p] = true;
+    }
+  }
+
+  template <class T, class Self>
+  static std::vector<FieldView<T>> fields_impl(Self& self) {
+    std::vector<FieldView<T>> out;
+    auto vec = [&](std::string_view n, auto& v) {
+      out.push_back({n, 3, {v.x.data(), v.y.data(), v.z.data()}});
+    };
+    auto scalar = [&](std::string_view n, auto& a) { out.push_back({n, 1, {a.data(), nullptr, nullptr}}); };
+    vec("position", self.position);
+    vec("velocity", self.velocity);
+    vec("acceleration", self.acceleration);
+    vec("acceleration_prev", self.acceleration_prev);
+    scalar("mass", self.mass);
+    scalar("density", self.density);
+    scalar("pressure", self.pressure);
+    for (auto& f : self.extra_) {
+      FieldView<T> v{f.name, f.components, {}};
+      for (int c = 0; c < f.components; ++c) v.data[c] = f.data[c].data();
+      out.push_back(v);
+    }
+    return out;
+  }
+
+  std::vector<ExtraField> extra_;
+};
+
+}  // namespace swirl

@@ -1,0 +1,40 @@
+// A small 3-vector value type for set-up code, configuration and diagnostics.
+//
+// Hot loops do not use it: they read the component arrays of a ParticleSet
+// directly so the compiler can vectorise them.
+#pragma once
+
+#include <array>
+#include <cmath>
+
+namespace swirl {
+
+template <class Real>
+struct Vec3 {
+  Real x{}, y{}, z{};
+
+  constexpr Real& operator[](int axis) { return axis == 0 ? x : (axis == 1 ? y : z); }
+  constexpr Real operator[](int axis) const { return axis == 0 ? x : (axis == 1 ? y : z); }
+
+  constexpr Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  constexpr Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
+  constexpr Vec3& operator*=(Real s) { x *= s; y *= s; z *= s; return *this; }
+  friend constexpr Vec3 operator+(Vec3 a, const Vec3& b) { return a += b; }
+  friend constexpr Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
+  friend constexpr Vec3 operator*(Vec3 a, Real s) { return a *= s; }
+  friend constexpr Vec3 operator*(Real s, Vec3 a) { return a *= s; }
+  friend constexpr bool operator==(const Vec3&, const Vec3&) = default;
+
+  template <class Other>
+  constexpr Vec3<Other> cast() const { return {Other(x), Other(y), Other(z)}; }
+};
+
+template <class Real>
+constexpr Real dot(const Vec3<Real>& a, const Vec3<Real>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+template <class Real>
+Real norm(const Vec3<Real>& a) { return std::sqrt(dot(a, a)); }
+
+using Vec3d = Vec3<double>;
+
+}  // namespace swirl

@@ -1,0 +1,85 @@
+// Scene: the typed, validated description of one simulation, made from a TOML
+// scene file by load_scene(). A solver never sees TOML; it sees this.
+//
+// Units are SI for SPH scenes (m, s, kg) and G = 1 N-body units for gravity
+// scenes. Every value here has passed validation: dt > 0, a valid box,
+// restitution in [0, 1], at least one particle, all particles inside the box.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "swirl/core/box.hpp"
+#include "swirl/core/vec3.hpp"
+
+namespace swirl::scene {
+
+enum class Precision { Float, Double };
+enum class OutputFormat { Vtp, Csv };
+
+// Particles on a simple cubic lattice filling `region` (points at
+// region.lo + spacing·(i + ½) per axis that lie inside the region), each moved
+// by a uniform random offset of up to jitter·spacing per axis.
+struct LatticeSource {
+  Box<double> region;
+  double spacing = 0;       // lattice constant, > 0
+  double jitter = 0;        // fraction of spacing, in [0, 0.5)
+  std::uint64_t seed = 1;   // for the jitter
+  double mass = 0;          // per particle, > 0
+  Vec3d velocity{};         // initial velocity of every particle
+};
+
+// `count` particles placed uniformly at random in `region`.
+struct RandomSource {
+  Box<double> region;
+  std::size_t count = 0;
+  std::uint64_t seed = 1;
+  double mass = 0;
+  Vec3d velocity{};
+};
+
+// Particles given one by one.
+struct ListSource {
+  std::vector<Vec3d> positions;
+  std::vector<Vec3d> velocities;  // empty (all at rest) or one per position
+  std::vector<double> masses;     // one per position
+};
+
+using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource>;
+
+struct Scene {
+  std::string file;                        // where it came from, for messages
+  Precision precision = Precision::Float;  // simulation.precision, default "float"
+  double dt = 0;                           // simulation.dt, s, > 0
+  std::optional<double> end_time;          // simulation.end_time, s (exactly one of end_time, steps)
+  std::optional<std::uint64_t> steps;      // simulation.steps
+  std::size_t block_size = 1024;           // simulation.block_size: particles per work block, ≥ 1
+
+  Box<double> box;                         // box.min, box.max, m
+  double restitution = 0.5;                // box.restitution, e in [0, 1]
+
+  Vec3d gravity{0, 0, -9.81};              // forces.gravity, m/s², uniform
+
+  double output_interval = 0;              // output.interval, s of simulated time; 0 = first and last frame only
+  std::vector<OutputFormat> formats{OutputFormat::Vtp};  // output.format: "vtp" and/or "csv"
+
+  std::vector<ParticleSource> sources;     // [[particles]]
+
+  // Number of steps the scene asks for: `steps`, or ceil(end_time / dt) (a step
+  // that would overshoot end_time by less than 1e-9·dt is not added).
+  std::uint64_t total_steps() const;
+};
+
+// A scene file that cannot be used. what() names the file, the key (or line
+// and column for syntax errors) and the reason, in one line.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+}  // namespace swirl::scene
