@@ -1,0 +1,59 @@
+# swirl: the two commands.
+#
+#   make demo   install what is missing (Debian packages), build, run the default scene
+#   make test   install what is missing, build, run every test with CTest
+#
+# Other targets: build, asan-test (tests under AddressSanitizer+UBSan, long
+# tests skipped), debug, clean, deps.
+
+PRESET   ?= release
+JOBS     ?= $(shell nproc)
+DEMO     ?= examples/falling_block.toml
+DEMO_OUT ?= out/demo
+
+# Debian 12 packages needed to build and test swirl.
+DEB_PACKAGES := cmake ninja-build g++ make git pkg-config \
+                libtomlplusplus-dev libcli11-dev libfmt-dev \
+                libgtest-dev libbenchmark-dev
+
+SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
+
+.PHONY: all deps configure build test demo asan-test debug clean
+
+all: build
+
+deps:
+	@missing=""; \
+	for p in $(DEB_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "swirl: installing Debian packages:$$missing"; \
+	  $(SUDO) apt-get update -q && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q --no-install-recommends $$missing; \
+	fi
+
+configure: deps
+	cmake --preset $(PRESET)
+
+build: configure
+	cmake --build --preset $(PRESET) -j $(JOBS)
+
+test: build
+	ctest --preset $(PRESET)
+
+demo: build
+	./build/swirl run $(DEMO) --out $(DEMO_OUT)
+	@echo "Open $(DEMO_OUT)/particles.pvd in ParaView."
+
+asan-test: deps
+	cmake --preset asan
+	cmake --build --preset asan -j $(JOBS)
+	ctest --preset asan
+
+debug: deps
+	cmake --preset debug
+	cmake --build --preset debug -j $(JOBS)
+
+clean:
+	rm -rf build build-debug build-asan build-portable out

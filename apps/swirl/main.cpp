@@ -1,0 +1,117 @@
+// swirl: the command-line tool. The only place that knows about files and flags.
+//
+//   swirl run SCENE [--threads N] [--out DIR] [--steps N] [--set key=value]... [--summary-json FILE]
+//   swirl info
+//
+// Exit status: 0 done, 1 the run failed (blow-up, write error), 2 bad input.
+#include <omp.h>
+
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "cli.hpp"
+#include "swirl/config.hpp"
+#include "swirl/io/atomic_file.hpp"
+#include "swirl/scene/load.hpp"
+#include "swirl/sim/run.hpp"
+
+namespace {
+
+// Widest SIMD registers the compiler was allowed to use for this binary.
+int vector_width_bits() {
+#if defined(__AVX512F__)
+  return 512;
+#elif defined(__AVX__)
+  return 256;
+#elif defined(__SSE2__) || defined(__ARM_NEON)
+  return 128;
+#else
+  return 0;
+#endif
+}
+
+int print_info() {
+  fmt::print("swirl {}\n", SWIRL_VERSION);
+  fmt::print("  git revision     {}\n", SWIRL_GIT_REVISION);
+  fmt::print("  build type       {}\n", SWIRL_BUILD_TYPE);
+  fmt::print("  compiler         {}\n", SWIRL_COMPILER);
+  fmt::print("  OpenMP           {} (threads {}, processors {})\n", _OPENMP, omp_get_max_threads(), omp_get_num_procs());
+  fmt::print("  vector width     {} bits ({} floats, {} doubles)\n", vector_width_bits(), vector_width_bits() / 32,
+             vector_width_bits() / 64);
+  return 0;
+}
+
+struct RunArgs {
+  std::string scene;
+  int threads = 0;
+  std::string out;
+  std::uint64_t steps = 0;
+  std::vector<std::string> overrides;
+  std::string summary_json;
+};
+
+int run(const RunArgs& args) {
+  const auto scene = swirl::scene::load_scene(args.scene, args.overrides);
+  swirl::sim::RunOptions options;
+  options.threads = args.threads;
+  options.out_dir = args.out.empty() ? std::filesystem::path("out") / std::filesystem::path(args.scene).stem()
+                                     : std::filesystem::path(args.out);
+  if (args.steps > 0) options.steps = args.steps;
+
+  swirl::cli::ProgressDisplay progress(stderr);
+  const auto summary = swirl::sim::run_scene(scene, options, [&](const auto& p) { progress.update(p); });
+  progress.finish();
+
+  fmt::print("{}\n{}", summary.error.empty() ? "swirl run: done" : "swirl run: STOPPED", swirl::cli::summary_text(summary));
+  if (!args.summary_json.empty()) swirl::io::write_file_atomic(args.summary_json, swirl::cli::summary_json(summary));
+  if (!summary.error.empty()) {
+    fmt::print(stderr, "swirl run: {}\nswirl run: frames written before the failure are intact in {}\n", summary.error,
+               options.out_dir.string());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"swirl: particle simulation (SPH fluids, Barnes-Hut gravity)", "swirl"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("swirl ") + SWIRL_VERSION + " (" + SWIRL_GIT_REVISION + ")");
+
+  RunArgs args;
+  auto* run_cmd = app.add_subcommand("run", "Run a scene file and write its frames");
+  run_cmd->add_option("scene", args.scene, "Scene file (TOML)")->required();
+  run_cmd->add_option("--threads,-t", args.threads, "Threads (default: all cores, or OMP_NUM_THREADS)")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--out,-o", args.out, "Output directory (default: out/<scene name>)");
+  run_cmd->add_option("--steps", args.steps, "Number of steps, replacing the scene's end time")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--set", args.overrides, "Override a scene key, e.g. --set box.restitution=0.9")
+      ->type_name("KEY=VALUE");
+  run_cmd->add_option("--summary-json", args.summary_json, "Also write the closing summary as JSON to FILE");
+
+  app.add_subcommand("info", "Print version, build and machine facts");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+
+  try {
+    if (app.got_subcommand("info")) return print_info();
+    return run(args);
+  } catch (const swirl::scene::SceneError& e) {
+    fmt::print(stderr, "swirl: error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "swirl: error: {}\n", e.what());
+    return 2;
+  }
+}

@@ -1,0 +1,60 @@
+#include <string>
+
+#include <fmt/format.h>
+
+#include "cli.hpp"
+
+namespace swirl::cli {
+namespace {
+
+std::string json_string(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\n': out += "\\n"; break;
+      case '\t': out += "\\t"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20) out += fmt::format("\\u{:04x}", static_cast<int>(c));
+        else out += c;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+std::string summary_text(const sim::RunSummary& s) {
+  std::string out;
+  out += fmt::format("  scene            {}\n", s.scene_file);
+  out += fmt::format("  particles        {} ({})\n", s.particles, s.precision);
+  out += fmt::format("  steps            {} (t = {:.6g} s)\n", s.steps, s.sim_time);
+  out += fmt::format("  wall time        {:.3f} s\n", s.wall_seconds);
+  out += fmt::format("  steps per second {:.2f}\n", s.steps_per_second);
+  out += fmt::format("  threads          {}\n", s.threads);
+  out += fmt::format("  bytes/particle   {}\n", s.bytes_per_particle);
+  out += fmt::format("  frames           {} in {}\n", s.frames, s.out_dir.string());
+  out += "  time per phase  ";
+  for (const auto& [name, seconds] : s.phases)
+    out += fmt::format(" {} {:.3f} s ({:.0f}%)", name, seconds, s.wall_seconds > 0 ? 100 * seconds / s.wall_seconds : 0.0);
+  out += "\n";
+  return out;
+}
+
+std::string summary_json(const sim::RunSummary& s) {
+  std::string phases;
+  for (const auto& [name, seconds] : s.phases)
+    phases += fmt::format("{}{}: {:.9g}", phases.empty() ? "" : ", ", json_string(name), seconds);
+  return fmt::format(
+      "{{\n"
+      "  \"scene\": {},\n  \"precision\": {},\n  \"out_dir\": {},\n  \"threads\": {},\n"
+      "  \"particles\": {},\n  \"steps\": {},\n  \"sim_time\": {:.17g},\n  \"wall_seconds\": {:.9g},\n"
+      "  \"steps_per_second\": {:.9g},\n  \"phase_seconds\": {{{}}},\n  \"bytes_per_particle\": {},\n"
+      "  \"frames\": {},\n  \"completed\": {},\n  \"error\": {}\n}}\n",
+      json_string(s.scene_file), json_string(s.precision), json_string(s.out_dir.string()), s.threads, s.particles,
+      s.steps, s.sim_time, s.wall_seconds, s.steps_per_second, phases, s.bytes_per_particle, s.frames,
+      s.error.empty() ? "true" : "false", s.error.empty() ? "null" : json_string(s.error));
+}
+
+}  // namespace swirl::cli

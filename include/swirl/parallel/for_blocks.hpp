@@ -1,0 +1,100 @@
+// The one wrapper through which every per-particle pass runs in parallel.
+//
+// It is the thesis's workpool (section 4, Algorithm 2) on today's cores: the
+// index range is cut into fixed work blocks of `block_size` items, and OpenMP
+// threads take blocks dynamically. Block boundaries depend only on n and
+// block_size, never on the thread count, so a pass whose blocks write disjoint
+// data (gather, not scatter) gives bit-identical results on any thread count;
+// reduce_blocks() keeps that promise for reductions by combining per-block
+// partial results in block order.
+//
+// An exception thrown inside a block is caught (OpenMP would terminate the
+// program), the loop finishes, and the first one is rethrown with the kernel's
+// name prepended.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <exception>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <omp.h>
+
+namespace swirl::parallel {
+
+// Threads the next parallel loop will use.
+inline int thread_count() { return omp_get_max_threads(); }
+
+// Sets the threads used by later loops; n ≥ 1.
+inline void set_thread_count(int n) {
+  if (n < 1) throw std::invalid_argument("thread count must be at least 1");
+  omp_set_num_threads(n);
+}
+
+// Number of blocks of block_size items covering n items.
+constexpr std::size_t block_count(std::size_t n, std::size_t block_size) {
+  return block_size == 0 ? 0 : (n + block_size - 1) / block_size;
+}
+
+namespace detail {
+class FirstError {
+ public:
+  void capture() noexcept {
+    std::lock_guard lock(mutex_);
+    if (!error_) error_ = std::current_exception();
+  }
+  void rethrow(std::string_view kernel) const {
+    if (!error_) return;
+    try {
+      std::rethrow_exception(error_);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string(kernel) + ": " + e.what());
+    }
+  }
+
+ private:
+  std::mutex mutex_;
+  std::exception_ptr error_;
+};
+}  // namespace detail
+
+// Calls body(begin, end, block) for every block [begin, end) of [0, n), in
+// parallel. body must only write data owned by its own block.
+template <class Body>
+void for_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
+  if (block_size == 0) throw std::invalid_argument(std::string(kernel) + ": block size must be at least 1");
+  const auto blocks = static_cast<std::int64_t>(block_count(n, block_size));
+  detail::FirstError error;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (std::int64_t b = 0; b < blocks; ++b) {
+    try {
+      const std::size_t begin = static_cast<std::size_t>(b) * block_size;
+      body(begin, std::min(n, begin + block_size), static_cast<std::size_t>(b));
+    } catch (...) {
+      error.capture();
+    }
+  }
+  error.rethrow(kernel);
+}
+
+// Computes partial = block_result(begin, end) for every block in parallel, then
+// folds them in block order: combine(combine(init, p0), p1)... Deterministic
+// for any thread count, also for floating-point sums.
+template <class T, class BlockResult, class Combine>
+T reduce_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, T init,
+                BlockResult&& block_result, Combine&& combine) {
+  std::vector<T> partial(block_count(n, block_size), init);
+  for_blocks(kernel, n, block_size, [&](std::size_t begin, std::size_t end, std::size_t b) {
+    partial[b] = block_result(begin, end);
+  });
+  T total = init;
+  for (const T& p : partial) total = combine(total, p);
+  return total;
+}
+
+}  // namespace swirl::parallel

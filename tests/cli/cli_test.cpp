@@ -1,0 +1,169 @@
+// The swirl command-line tool, run as a user runs it.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "swirl/io/pvd.hpp"
+#include "swirl/io/vtp.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("swirl_cli_" + std::to_string(::getpid()) + "_" +
+                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  Result swirl(const std::string& args) {
+    const auto out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(SWIRL_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+    Result r;
+    const int raw = std::system(cmd.c_str());
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
+    r.out = slurp(out);
+    r.err = slurp(err);
+    return r;
+  }
+
+  fs::path write_scene(const std::string& name, const std::string& text) {
+    const auto p = dir_ / name;
+    std::ofstream(p) << text;
+    return p;
+  }
+
+  fs::path dir_;
+};
+
+const char* kSmallScene = R"(
+[simulation]
+precision = "double"
+dt = 0.01
+end_time = 0.5
+
+[box]
+min = [0.0, 0.0, 0.0]
+max = [1.0, 1.0, 1.0]
+restitution = 0.5
+
+[output]
+interval = 0.1
+format = ["vtp", "csv"]
+
+[[particles]]
+kind = "lattice"
+min = [0.2, 0.2, 0.5]
+max = [0.8, 0.8, 0.9]
+spacing = 0.1
+mass = 0.001
+)";
+
+TEST_F(Cli, RunWritesFramesSeriesAndSummary) {
+  const auto scene = write_scene("small.toml", kSmallScene);
+  const auto out = dir_ / "out";
+  const auto json = dir_ / "summary.json";
+  const auto r = swirl("run " + scene.string() + " --threads 2 --out " + out.string() + " --summary-json " + json.string());
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("steps per second"), std::string::npos) << r.out;
+
+  // Frames at t = 0, 0.1, ..., 0.5, listed in the .pvd with their times.
+  const auto entries = swirl::io::read_pvd(out / "particles.pvd");
+  ASSERT_EQ(entries.size(), 6u);
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    EXPECT_NEAR(entries[k].time, 0.1 * double(k), 1e-12);
+    EXPECT_TRUE(fs::exists(out / entries[k].file)) << entries[k].file;
+    EXPECT_TRUE(fs::exists(out / fs::path(entries[k].file).replace_extension(".csv")));
+  }
+  const auto last = swirl::io::read_vtp(out / entries.back().file);
+  EXPECT_EQ(last.num_points, 6u * 6u * 4u);
+  const auto z = last.points.values<double>();
+  for (std::size_t i = 2; i < z.size(); i += 3) EXPECT_LT(z[i], 0.9);  // it fell
+
+  const std::string summary = slurp(json);
+  EXPECT_NE(summary.find("\"particles\": 144"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"steps\": 50"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"completed\": true"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"forces\""), std::string::npos) << summary;
+  EXPECT_NE(summary.find("\"bytes_per_particle\": 128"), std::string::npos) << summary;  // 15 doubles + id
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "left-over " << e.path();
+}
+
+TEST_F(Cli, StepsAndSetOverrideTheScene) {
+  const auto scene = write_scene("small.toml", kSmallScene);
+  const auto json = dir_ / "s.json";
+  auto r = swirl("run " + scene.string() + " --out " + (dir_ / "a").string() + " --steps 7 --summary-json " + json.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(json).find("\"steps\": 7,"), std::string::npos);
+  r = swirl("run " + scene.string() + " --out " + (dir_ / "b").string() +
+            " --set simulation.end_time=0.05 --set output.format='\"csv\"' --summary-json " + json.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(slurp(json).find("\"steps\": 5,"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ / "b" / "particles.pvd"));
+  EXPECT_TRUE(fs::exists(dir_ / "b" / "particles_000000.csv"));
+}
+
+TEST_F(Cli, ABadSceneIsRefusedWithFileKeyAndReasonAndNothingIsWritten) {
+  std::string text = kSmallScene;
+  text.replace(text.find("dt = 0.01"), 9, "dt = -0.01");
+  const auto scene = write_scene("bad.toml", text);
+  const auto out = dir_ / "never";
+  const auto r = swirl("run " + scene.string() + " --out " + out.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bad.toml"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("simulation.dt"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST_F(Cli, AMissingSceneFileIsAClearError) {
+  const auto r = swirl("run " + (dir_ / "nope.toml").string() + " --out " + (dir_ / "o").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("nope.toml"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+TEST_F(Cli, AnUnwritableOutputDirectoryIsRefusedBeforeRunning) {
+  const auto scene = write_scene("small.toml", kSmallScene);
+  std::ofstream(dir_ / "file") << "x";
+  const auto r = swirl("run " + scene.string() + " --out " + (dir_ / "file" / "sub").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("file/sub"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("steps per second"), std::string::npos);
+}
+
+TEST_F(Cli, InfoNamesTheBuild) {
+  const auto r = swirl("info");
+  ASSERT_EQ(r.status, 0);
+  for (const char* key : {"git revision", "build type", "compiler", "threads", "vector width"})
+    EXPECT_NE(r.out.find(key), std::string::npos) << key;
+}
+
+TEST_F(Cli, UsageErrorsExitNonZero) {
+  EXPECT_NE(swirl("").status, 0);
+  EXPECT_NE(swirl("run").status, 0);
+  EXPECT_NE(swirl("run x.toml --threads 0").status, 0);
+}
+
+}  // namespace

@@ -1,0 +1,81 @@
+#include "swirl/parallel/for_blocks.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <vector>
+
+namespace {
+
+using swirl::parallel::for_blocks;
+using swirl::parallel::reduce_blocks;
+
+TEST(ForBlocks, VisitsEveryIndexExactlyOnceInFixedBlocks) {
+  for (int threads : {1, 2, 3}) {
+    swirl::parallel::set_thread_count(threads);
+    for (std::size_t n : {0ul, 1ul, 7ul, 64ul, 1000ul}) {
+      std::vector<int> hits(n, 0);
+      std::vector<std::size_t> block_of(n, 999);
+      for_blocks("test", n, 7, [&](std::size_t b, std::size_t e, std::size_t block) {
+        ASSERT_EQ(b, block * 7);
+        ASSERT_LE(e - b, 7u);
+        for (std::size_t i = b; i < e; ++i) {
+          ++hits[i];
+          block_of[i] = block;
+        }
+      });
+      for (std::size_t i = 0; i < n; ++i) {
+        EXPECT_EQ(hits[i], 1);
+        EXPECT_EQ(block_of[i], i / 7);
+      }
+    }
+  }
+}
+
+TEST(ForBlocks, UsesSeveralThreadsWhenAsked) {
+  swirl::parallel::set_thread_count(2);
+  std::atomic<int> max_seen{0};
+  for_blocks("test", 64, 1, [&](std::size_t, std::size_t, std::size_t) {
+    int t = omp_get_num_threads();
+    int prev = max_seen.load();
+    while (t > prev && !max_seen.compare_exchange_weak(prev, t)) {}
+  });
+  EXPECT_EQ(max_seen.load(), 2);
+}
+
+TEST(ReduceBlocks, FloatingPointSumIsBitIdenticalForAnyThreadCount) {
+  std::vector<double> values(100000);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::sin(double(i)) * 1e-3 + 1.0 / double(i + 1);
+  auto sum_with = [&](int threads) {
+    swirl::parallel::set_thread_count(threads);
+    return reduce_blocks(
+        "sum", values.size(), 97, 0.0,
+        [&](std::size_t b, std::size_t e) {
+          double s = 0;
+          for (std::size_t i = b; i < e; ++i) s += values[i];
+          return s;
+        },
+        [](double x, double y) { return x + y; });
+  };
+  const double one = sum_with(1);
+  EXPECT_EQ(sum_with(2), one);
+  EXPECT_EQ(sum_with(3), one);
+  EXPECT_NEAR(one, 12.0900, 0.01);  // harmonic number H(1e5) ≈ 12.09 plus a small sine sum
+}
+
+TEST(ForBlocks, AnExceptionInABlockIsRethrownWithTheKernelName) {
+  swirl::parallel::set_thread_count(2);
+  try {
+    for_blocks("my_kernel", 100, 10, [](std::size_t b, std::size_t, std::size_t) {
+      if (b == 50) throw std::runtime_error("bad block");
+    });
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "my_kernel: bad block");
+  }
+  EXPECT_THROW(for_blocks("k", 10, 0, [](std::size_t, std::size_t, std::size_t) {}), std::invalid_argument);
+  EXPECT_THROW(swirl::parallel::set_thread_count(0), std::invalid_argument);
+}
+
+}  // namespace
