@@ -22,9 +22,11 @@ namespace swirl::scene {
 enum class Precision { Float, Double };
 enum class OutputFormat { Vtp, Csv };
 
-// Particles on a simple cubic lattice filling `region` (points at
-// region.lo + spacing·(i + ½) per axis that lie inside the region), each moved
-// by a uniform random offset of up to jitter·spacing per axis.
+// Particles on a simple cubic lattice filling `region`: one at the centre of
+// every spacing-sized cell that fits wholly inside the region, i.e.
+// floor(extent / spacing) points per axis at region.lo + spacing·(i + ½)
+// (docs/scenes.md gives the exact rule), each moved by a uniform random offset
+// of up to jitter·spacing per axis.
 struct LatticeSource {
   Box<double> region;
   double spacing = 0;       // lattice constant, > 0

@@ -1,0 +1,174 @@
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <variant>
+
+#include <fmt/format.h>
+
+#include "sources.hpp"
+#include "swirl/scene/initial_conditions.hpp"
+
+namespace swirl::scene {
+namespace detail {
+
+std::array<std::uint64_t, 3> lattice_counts(const LatticeSource& source) {
+  std::array<std::uint64_t, 3> n{};
+  const Vec3d extent = source.region.extent();
+  for (int axis = 0; axis < 3; ++axis) {
+    const double r = extent[axis] / source.spacing;
+    // Beyond 2^53 the count is far over the particle limit anyway, and the
+    // conversion below would no longer be exact (or defined, for inf and NaN).
+    if (std::isnan(r) || r >= 0x1p53) {
+      n[axis] = kSaturated;
+    } else if (r > 0) {
+      // The tolerance absorbs rounding in extent / spacing (0.3 / 0.1 = 2.9999999999999996).
+      n[axis] = static_cast<std::uint64_t>(std::floor(r + r * 1e-12));
+    }
+  }
+  return n;
+}
+
+std::uint64_t source_count(const ParticleSource& source) {
+  struct {
+    std::uint64_t operator()(const LatticeSource& s) const {
+      const auto n = lattice_counts(s);
+      return mul_sat(mul_sat(n[0], n[1]), n[2]);
+    }
+    std::uint64_t operator()(const RandomSource& s) const { return s.count; }
+    std::uint64_t operator()(const ListSource& s) const { return s.positions.size(); }
+  } count;
+  return std::visit(count, source);
+}
+
+}  // namespace detail
+
+namespace {
+
+// splitmix64 (Steele, Lea and Flood 2014), written out here because the standard
+// distributions differ between standard libraries and the particles must not.
+class SplitMix64 {
+ public:
+  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
+  std::uint64_t next() {
+    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15u);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9u;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBu;
+    return z ^ (z >> 31);
+  }
+  // Uniform in [0, 1): the top 53 bits, so every value is exact in a double.
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
+
+ private:
+  std::uint64_t state_;
+};
+
+// a + b·c rounded twice. Separate statements, because a compiler may fuse one
+// expression into a multiply-add (Clang does by default), which rounds once and
+// would move particles by an ulp on some machines only.
+double mul_add(double a, double b, double c) {
+  const double bc = b * c;
+  return a + bc;
+}
+
+// Rounding in lo + u·extent can land an ulp past the region; the region must hold.
+Vec3d clamp_to(const Box<double>& region, Vec3d p) {
+  for (int axis = 0; axis < 3; ++axis) p[axis] = std::clamp(p[axis], region.lo[axis], region.hi[axis]);
+  return p;
+}
+
+template <class Real>
+class Filler {
+ public:
+  explicit Filler(ParticleSet<Real>& out) : out_(out) {}
+
+  void put(const Vec3d& x, const Vec3d& v, double m) {
+    out_.position.set(next_, x.cast<Real>());
+    out_.velocity.set(next_, v.cast<Real>());
+    out_.mass[next_] = static_cast<Real>(m);
+    out_.id[next_] = next_;
+    ++next_;
+  }
+
+  void operator()(const LatticeSource& s) {
+    const auto n = detail::lattice_counts(s);
+    const double amplitude = s.jitter * s.spacing;
+    SplitMix64 rng(s.seed);
+    for (std::uint64_t k = 0; k < n[2]; ++k) {
+      for (std::uint64_t j = 0; j < n[1]; ++j) {
+        for (std::uint64_t i = 0; i < n[0]; ++i) {
+          const std::uint64_t index[3] = {i, j, k};
+          Vec3d p;
+          for (int axis = 0; axis < 3; ++axis)
+            p[axis] = mul_add(s.region.lo[axis], s.spacing, static_cast<double>(index[axis]) + 0.5);
+          if (amplitude > 0)
+            for (int axis = 0; axis < 3; ++axis) p[axis] = mul_add(p[axis], amplitude, 2 * rng.uniform() - 1);
+          put(clamp_to(s.region, p), s.velocity, s.mass);
+        }
+      }
+    }
+  }
+
+  void operator()(const RandomSource& s) {
+    SplitMix64 rng(s.seed);
+    const Vec3d extent = s.region.extent();
+    for (std::size_t n = 0; n < s.count; ++n) {
+      Vec3d p;
+      for (int axis = 0; axis < 3; ++axis) p[axis] = mul_add(s.region.lo[axis], rng.uniform(), extent[axis]);
+      put(clamp_to(s.region, p), s.velocity, s.mass);
+    }
+  }
+
+  void operator()(const ListSource& s) {
+    for (std::size_t n = 0; n < s.positions.size(); ++n)
+      put(s.positions[n], s.velocities.empty() ? Vec3d{} : s.velocities[n], s.masses[n]);
+  }
+
+ private:
+  ParticleSet<Real>& out_;
+  std::size_t next_ = 0;
+};
+
+// A Scene built in code has not been through validation; these would otherwise
+// read out of bounds or allocate without limit.
+void check_buildable(const Scene& scene, std::uint64_t count) {
+  if (count > detail::kMaxParticles)
+    throw SceneError(fmt::format("{}: particles: {} particles, more than the limit of {} (2^31)", scene.file,
+                                 count == detail::kSaturated ? std::string("over 1.8e19") : std::to_string(count),
+                                 detail::kMaxParticles));
+  for (std::size_t k = 0; k < scene.sources.size(); ++k) {
+    const auto* list = std::get_if<ListSource>(&scene.sources[k]);
+    if (list && (list->masses.size() != list->positions.size() ||
+                 (!list->velocities.empty() && list->velocities.size() != list->positions.size())))
+      throw SceneError(fmt::format("{}: particles[{}]: masses and velocities must have one entry per position",
+                                   scene.file, k));
+  }
+}
+
+std::uint64_t total_count(const Scene& scene) {
+  std::uint64_t total = 0;
+  for (const auto& source : scene.sources) total = detail::add_sat(total, detail::source_count(source));
+  return total;
+}
+
+}  // namespace
+
+std::size_t count_particles(const Scene& scene) {
+  const std::uint64_t total = total_count(scene);
+  return total > std::numeric_limits<std::size_t>::max() ? std::numeric_limits<std::size_t>::max()
+                                                         : static_cast<std::size_t>(total);
+}
+
+template <class Real>
+ParticleSet<Real> make_particles(const Scene& scene) {
+  const std::uint64_t count = total_count(scene);
+  check_buildable(scene, count);
+  ParticleSet<Real> particles(static_cast<std::size_t>(count));
+  Filler<Real> fill(particles);
+  for (const auto& source : scene.sources) std::visit(fill, source);
+  return particles;
+}
+
+template ParticleSet<float> make_particles<float>(const Scene&);
+template ParticleSet<double> make_particles<double>(const Scene&);
+
+}  // namespace swirl::scene
