@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "sources.hpp"
+#include "swirl/core/random.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 
 namespace swirl::scene {
@@ -43,24 +44,6 @@ std::uint64_t source_count(const ParticleSource& source) {
 }  // namespace detail
 
 namespace {
-
-// splitmix64 (Steele, Lea and Flood 2014), written out here because the standard
-// distributions differ between standard libraries and the particles must not.
-class SplitMix64 {
- public:
-  explicit SplitMix64(std::uint64_t seed) : state_(seed) {}
-  std::uint64_t next() {
-    std::uint64_t z = (state_ += 0x9E3779B97F4A7C15u);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9u;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBu;
-    return z ^ (z >> 31);
-  }
-  // Uniform in [0, 1): the top 53 bits, so every value is exact in a double.
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
-
- private:
-  std::uint64_t state_;
-};
 
 // a + b·c rounded twice. Separate statements, because a compiler may fuse one
 // expression into a multiply-add (Clang does by default), which rounds once and

@@ -1,0 +1,197 @@
+// SpatialHash<Real>: the thesis's neighbour search (section 4.2).
+//
+// build(): every particle gets its cell (floor(x / h)) and the Teschner hash of
+// that cell into M buckets; the table is then built by a stable counting sort
+// (count, prefix sum into the offset table, scatter — in parallel, where the
+// thesis ran it serially), and the positions are copied into bucket order as
+// the thesis's table holds them.
+//
+// find_neighbors(): for every particle, in bucket order (the thesis walks the
+// table bucket by bucket, Algorithm 4), all 27 cells around its cell are
+// hashed and their buckets scanned. A particle found in a scanned bucket whose
+// cell is not the searched one is there by a hash collision: with the
+// duplicate check on (the default) it is skipped, which also drops the
+// duplicate interactions that arise when two of the 27 cells share a bucket;
+// with it off (the thesis's faster option) such pairs are distance-tested and
+// duplicates can appear. Interaction lists are CSR (NeighborList), one row per
+// particle in bucket order, neighbours in scan order: deterministic for any
+// thread count.
+//
+// Invariant: with the check on, the interactions are exactly the pairs of
+// brute_force_pairs() (tested).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+#include "swirl/core/particle_set.hpp"
+#include "swirl/parallel/counting_sort.hpp"
+#include "swirl/parallel/for_blocks.hpp"
+#include "swirl/spatial/distance.hpp"
+#include "swirl/spatial/neighbor_list.hpp"
+#include "swirl/spatial/teschner_hash.hpp"
+
+namespace swirl::spatial {
+
+// What a search saw, for the thesis's Table 5.2.
+struct SearchCounters {
+  std::uint64_t tests = 0;            // candidate pairs (i, j ≠ i) taken from scanned buckets
+  std::uint64_t redundant_tests = 0;  // of which j's cell is not the searched cell (hash collisions)
+  std::uint64_t interactions = 0;     // pairs put in the lists
+
+  SearchCounters& operator+=(const SearchCounters& o) {
+    tests += o.tests;
+    redundant_tests += o.redundant_tests;
+    interactions += o.interactions;
+    return *this;
+  }
+};
+
+template <class Real>
+class SpatialHash {
+ public:
+  // Hashes the particles with cell length h (> 0) into `buckets` (≥ 1) buckets
+  // and builds the table.
+  void build(const ParticleSet<Real>& p, Real h, std::uint32_t buckets, std::size_t block_size) {
+    if (!(h > Real(0))) throw std::invalid_argument("spatial hash: cell length must be > 0");
+    if (buckets == 0) throw std::invalid_argument("spatial hash: at least one bucket");
+    h_ = h;
+    const std::size_t n = p.size();
+    cells_.resize(n);
+    hashes_.resize(n);
+    parallel::for_blocks("hash_particles", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t i = b; i < e; ++i) {
+        cells_[i] = cell_of(p.position.x[i], p.position.y[i], p.position.z[i], h);
+        hashes_[i] = hash_cell(cells_[i], buckets);
+      }
+    });
+    sort_.sort(hashes_, buckets);
+    const auto& order = sort_.order();
+    for (int axis = 0; axis < 3; ++axis) sorted_position_[axis].resize(n);
+    parallel::for_blocks("fill_table", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (int axis = 0; axis < 3; ++axis) {
+        const Real* x = p.position[axis].data();
+        Real* s = sorted_position_[axis].data();
+        for (std::size_t slot = b; slot < e; ++slot) s[slot] = x[order[slot]];
+      }
+    });
+  }
+
+  // Fills `out` with the interaction lists of every particle (see the header
+  // comment) and calls on_row(i, neighbors, r2, count) right after particle i's
+  // row is complete (the thesis computes density and pressure there, Algorithm
+  // 4). on_row runs in parallel and may only write particle i's data. If
+  // `counters` is given, it receives the totals of the search.
+  template <class OnRow>
+  void find_neighbors(const ParticleSet<Real>& p, bool duplicate_check, std::size_t block_size,
+                      NeighborList<Real>& out, OnRow&& on_row, SearchCounters* counters = nullptr) {
+    const std::size_t n = p.size();
+    if (cells_.size() != n) throw std::logic_error("spatial hash: find_neighbors() on particles it was not built for");
+    const std::size_t blocks = parallel::block_count(n, block_size);
+    if (block_lists_.size() < blocks) block_lists_.resize(blocks);
+    std::vector<SearchCounters> block_counters(counters ? blocks : 0);
+    const Real h2 = h_ * h_;
+    const std::uint32_t buckets = bucket_count();
+    const auto& order = sort_.order();
+    const auto& offsets = sort_.offsets();
+
+    parallel::for_blocks("neighbor_search", n, block_size, [&](std::size_t first, std::size_t last, std::size_t blk) {
+      BlockList& list = block_lists_[blk];
+      list.neighbor.clear();
+      list.r2.clear();
+      list.row_end.clear();
+      SearchCounters local;
+      for (std::size_t row = first; row < last; ++row) {
+        const std::uint32_t i = order[row];
+        const Real xi = sorted_position_[0][row], yi = sorted_position_[1][row], zi = sorted_position_[2][row];
+        const Cell ci = cells_[i];
+        const std::size_t row_begin = list.neighbor.size();
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di) {
+              const Cell c{wrap(ci.i, di), wrap(ci.j, dj), wrap(ci.k, dk)};
+              const std::uint32_t b = hash_cell(c, buckets);
+              for (std::uint32_t s = offsets[b]; s < offsets[b + 1]; ++s) {
+                const std::uint32_t j = order[s];
+                if (j == i) continue;
+                const bool same_cell = cells_[j] == c;
+                if (counters) {
+                  ++local.tests;
+                  local.redundant_tests += same_cell ? 0 : 1;
+                }
+                if (duplicate_check && !same_cell) continue;
+                const Real r2 = distance2(xi, yi, zi, sorted_position_[0][s], sorted_position_[1][s],
+                                          sorted_position_[2][s]);
+                if (within(r2, h2)) {
+                  list.neighbor.push_back(j);
+                  list.r2.push_back(r2);
+                }
+              }
+            }
+        list.row_end.push_back(list.neighbor.size());
+        on_row(i, list.neighbor.data() + row_begin, list.r2.data() + row_begin, list.neighbor.size() - row_begin);
+      }
+      if (counters) {
+        local.interactions = list.neighbor.size();
+        block_counters[blk] = local;
+      }
+    });
+    gather(n, blocks, block_size, out);
+    if (counters) {
+      *counters = {};
+      for (const auto& c : block_counters) *counters += c;
+    }
+  }
+
+  Real cell_size() const { return h_; }
+  std::uint32_t bucket_count() const { return static_cast<std::uint32_t>(sort_.offsets().size() - 1); }
+  // offsets()[b] .. offsets()[b+1]: the slots of bucket b in order().
+  const std::vector<std::uint32_t>& offsets() const { return sort_.offsets(); }
+  // Particle index in each slot, bucket by bucket, by index within a bucket.
+  const std::vector<std::uint32_t>& order() const { return sort_.order(); }
+  const std::vector<Cell>& cells() const { return cells_; }        // per particle
+  const std::vector<std::uint32_t>& hashes() const { return hashes_; }  // per particle
+
+ private:
+  struct BlockList {
+    std::vector<std::uint32_t> neighbor;
+    std::vector<Real> r2;
+    std::vector<std::size_t> row_end;  // end of each row in neighbor, block-local
+  };
+
+  // Neighbour cell coordinate with the wrap-around the hash uses anyway
+  // (cells at the int32 limits are clamped, see cell_coordinate()).
+  static std::int32_t wrap(std::int32_t c, int d) {
+    return static_cast<std::int32_t>(static_cast<std::uint32_t>(c) + static_cast<std::uint32_t>(d));
+  }
+
+  // Concatenates the block lists into one CSR list, in block order.
+  void gather(std::size_t n, std::size_t blocks, std::size_t block_size, NeighborList<Real>& out) {
+    std::vector<std::size_t> block_start(blocks + 1, 0);
+    for (std::size_t b = 0; b < blocks; ++b) block_start[b + 1] = block_start[b] + block_lists_[b].neighbor.size();
+    out.row_particle.assign(sort_.order().begin(), sort_.order().end());
+    out.offsets.resize(n + 1);
+    out.neighbor.resize(block_start[blocks]);
+    out.r2.resize(block_start[blocks]);
+    out.offsets[0] = 0;
+    parallel::for_blocks("gather_lists", n, block_size, [&](std::size_t first, std::size_t last, std::size_t b) {
+      const BlockList& list = block_lists_[b];
+      std::copy(list.neighbor.begin(), list.neighbor.end(), out.neighbor.begin() + static_cast<std::ptrdiff_t>(block_start[b]));
+      std::copy(list.r2.begin(), list.r2.end(), out.r2.begin() + static_cast<std::ptrdiff_t>(block_start[b]));
+      for (std::size_t row = first; row < last; ++row) out.offsets[row + 1] = block_start[b] + list.row_end[row - first];
+    });
+  }
+
+  Real h_ = Real(1);
+  std::vector<Cell> cells_;
+  std::vector<std::uint32_t> hashes_;
+  parallel::CountingSort sort_;
+  std::array<std::vector<Real>, 3> sorted_position_;
+  std::vector<BlockList> block_lists_;  // kept between searches to avoid reallocation
+};
+
+}  // namespace swirl::spatial

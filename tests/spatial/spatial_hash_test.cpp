@@ -1,0 +1,197 @@
+// The spatial hash against its slow twin, brute force.
+#include "swirl/spatial/spatial_hash.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "swirl/core/random.hpp"
+#include "swirl/parallel/counting_sort.hpp"
+#include "swirl/spatial/brute_force.hpp"
+#include "swirl/spatial/hash_statistics.hpp"
+
+namespace {
+
+using namespace swirl;
+using namespace swirl::spatial;
+using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+template <class Real>
+class SpatialHashTest : public ::testing::Test {};
+using Precisions = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(SpatialHashTest, Precisions);
+
+// n particles uniformly in [lo, lo + side)³, some negative coordinates included.
+template <class Real>
+ParticleSet<Real> random_particles(std::size_t n, double lo, double side, std::uint64_t seed) {
+  ParticleSet<Real> p(n);
+  SplitMix64 rng(seed);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int axis = 0; axis < 3; ++axis) p.position[axis][i] = Real(lo + side * rng.uniform());
+    p.mass[i] = Real(1);
+    p.id[i] = i;
+  }
+  return p;
+}
+
+template <class Real>
+Pairs pairs_of(const NeighborList<Real>& l) {
+  Pairs pairs;
+  for (std::size_t row = 0; row < l.rows(); ++row)
+    for (std::size_t k = l.offsets[row]; k < l.offsets[row + 1]; ++k) pairs.emplace_back(l.row_particle[row], l.neighbor[k]);
+  std::sort(pairs.begin(), pairs.end());
+  return pairs;
+}
+
+template <class Real>
+NeighborList<Real> search(const ParticleSet<Real>& p, Real h, std::uint32_t buckets, bool check,
+                          SearchCounters* counters = nullptr, std::size_t block_size = 37) {
+  SpatialHash<Real> hash;
+  hash.build(p, h, buckets, block_size);
+  NeighborList<Real> lists;
+  hash.find_neighbors(p, check, block_size, lists, [](auto, auto, auto, auto) {}, counters);
+  return lists;
+}
+
+TYPED_TEST(SpatialHashTest, WithTheCheckOnTheListsAreExactlyTheBruteForcePairs) {
+  using Real = TypeParam;
+  for (std::uint32_t buckets : {1u, 2u, 7u, 97u, 1601u, 100003u}) {
+    const auto p = random_particles<Real>(1000, -0.7, 1.9, buckets);
+    const Real h = Real(0.15);
+    const auto lists = search(p, h, buckets, true);
+    ASSERT_EQ(lists.rows(), p.size());
+    std::vector<int> rows_of(p.size(), 0);
+    for (auto i : lists.row_particle) ++rows_of[i];
+    EXPECT_TRUE(std::all_of(rows_of.begin(), rows_of.end(), [](int c) { return c == 1; }));
+    const auto expected = brute_force_pairs(p, h);
+    ASSERT_GT(expected.size(), 1000u);  // a meaningful number of pairs
+    EXPECT_EQ(pairs_of(lists), expected) << "buckets = " << buckets;
+    // r² is stored exactly as the shared distance function computes it.
+    for (std::size_t row = 0; row < lists.rows(); ++row)
+      for (std::size_t k = lists.offsets[row]; k < lists.offsets[row + 1]; ++k) {
+        const auto i = lists.row_particle[row], j = lists.neighbor[k];
+        ASSERT_EQ(lists.r2[k], distance2(p.position.x[i], p.position.y[i], p.position.z[i], p.position.x[j],
+                                         p.position.y[j], p.position.z[j]));
+      }
+  }
+}
+
+TYPED_TEST(SpatialHashTest, WithTheCheckOffTheExtraPairsAreTheReportedDuplicates) {
+  using Real = TypeParam;
+  for (std::uint32_t buckets : {1u, 3u, 11u, 389u}) {  // tiny tables force collisions among the 27 cells
+    const auto p = random_particles<Real>(600, 0.0, 1.0, 7 + buckets);
+    const Real h = Real(0.12);
+    const auto unchecked = pairs_of(search(p, h, buckets, false));
+    const auto checked = pairs_of(search(p, h, buckets, true));
+    // Without the check every true pair is still found, some more than once.
+    Pairs unique = unchecked;
+    unique.erase(std::unique(unique.begin(), unique.end()), unique.end());
+    EXPECT_EQ(unique, checked);
+    const auto stats = hash_statistics(p, h, buckets, 64);
+    EXPECT_EQ(stats.interactions, checked.size());
+    EXPECT_EQ(stats.duplicate_interactions, unchecked.size() - checked.size());
+    if (buckets <= 11) {
+      EXPECT_GT(stats.duplicate_interactions, 0u);
+    }
+  }
+}
+
+// Table 5.2's counts, recomputed by brute force from the definitions.
+TYPED_TEST(SpatialHashTest, HashStatisticsMatchBruteForceCounts) {
+  using Real = TypeParam;
+  const Real h = Real(0.1);
+  for (std::uint32_t buckets : {5u, 61u, 1601u}) {
+    const auto p = random_particles<Real>(500, -0.3, 0.9, 99 + buckets);
+    const auto s = hash_statistics(p, h, buckets, 50);
+
+    std::vector<Cell> cells(p.size());
+    std::vector<std::uint32_t> bucket(p.size());
+    std::map<std::uint32_t, std::set<std::tuple<int, int, int>>> cells_in_bucket;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      cells[i] = cell_of(p.position.x[i], p.position.y[i], p.position.z[i], h);
+      bucket[i] = hash_cell(cells[i], buckets);
+      cells_in_bucket[bucket[i]].insert({cells[i].i, cells[i].j, cells[i].k});
+    }
+    std::uint64_t collisions = 0;
+    for (const auto& [b, set] : cells_in_bucket) collisions += set.size() > 1 ? 1 : 0;
+    EXPECT_EQ(s.empty_buckets, buckets - cells_in_bucket.size());
+    EXPECT_EQ(s.buckets_with_collisions, collisions);
+
+    std::uint64_t tests = 0, redundant = 0, duplicates = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      std::vector<std::pair<Cell, std::uint32_t>> searched;
+      for (int dk = -1; dk <= 1; ++dk)
+        for (int dj = -1; dj <= 1; ++dj)
+          for (int di = -1; di <= 1; ++di) {
+            const Cell c{cells[i].i + di, cells[i].j + dj, cells[i].k + dk};
+            searched.emplace_back(c, hash_cell(c, buckets));
+          }
+      for (std::size_t j = 0; j < p.size(); ++j) {
+        if (j == i) continue;
+        int found = 0;
+        for (const auto& [c, b] : searched) {
+          if (bucket[j] != b) continue;
+          ++tests;
+          if (!(cells[j] == c)) ++redundant;
+          ++found;
+        }
+        const Real r2 = distance2(p.position.x[i], p.position.y[i], p.position.z[i], p.position.x[j],
+                                  p.position.y[j], p.position.z[j]);
+        if (within(r2, h * h)) duplicates += static_cast<std::uint64_t>(found - 1);
+      }
+    }
+    EXPECT_EQ(s.tests, tests);
+    EXPECT_EQ(s.redundant_tests, redundant);
+    EXPECT_EQ(s.duplicate_interactions, duplicates);
+    EXPECT_EQ(s.interactions, brute_force_pairs(p, h).size());
+  }
+}
+
+TYPED_TEST(SpatialHashTest, ListsAreIdenticalForAnyThreadCount) {
+  using Real = TypeParam;
+  const auto p = random_particles<Real>(5000, 0.0, 1.0, 5);
+  auto with = [&](int threads) {
+    parallel::set_thread_count(threads);
+    return search(p, Real(0.08), 8001u, true, nullptr, 64);
+  };
+  const auto one = with(1);
+  for (int t : {2, 3}) {
+    const auto other = with(t);
+    EXPECT_EQ(other.row_particle, one.row_particle);
+    EXPECT_EQ(other.offsets, one.offsets);
+    EXPECT_EQ(other.neighbor, one.neighbor);
+    EXPECT_EQ(other.r2, one.r2);
+  }
+}
+
+TEST(TeschnerHash, MatchesTheFormulaWithWrapAround) {
+  // ((uint32)(-1)·P1 ^ 2·P2 ^ 3·P3) mod 24001, by hand with 32-bit wrap-around.
+  const std::uint32_t h = ((0xffffffffu * 73856093u) ^ (2u * 19349663u) ^ (3u * 83492791u)) % 24001u;
+  EXPECT_EQ(hash_cell(Cell{-1, 2, 3}, 24001u), h);
+  EXPECT_EQ(cell_of(-0.5, 0.0, 1.99, 1.0), (Cell{-1, 0, 1}));
+  EXPECT_EQ(cell_of(2.0, -2.0, 1e30, 1.0), (Cell{2, -2, 2147483647}));
+}
+
+TEST(CountingSort, IsTheStableSortForAnyThreadCount) {
+  SplitMix64 rng(3);
+  std::vector<std::uint32_t> keys(50000);
+  for (auto& k : keys) k = static_cast<std::uint32_t>(rng.next() % 1000);
+  std::vector<std::uint32_t> expected(keys.size());
+  for (std::uint32_t i = 0; i < expected.size(); ++i) expected[i] = i;
+  std::stable_sort(expected.begin(), expected.end(), [&](auto a, auto b) { return keys[a] < keys[b]; });
+  for (int threads : {1, 2, 3}) {
+    parallel::set_thread_count(threads);
+    parallel::CountingSort sort;
+    sort.sort(keys, 1000);
+    EXPECT_EQ(sort.order(), expected);
+    ASSERT_EQ(sort.offsets().size(), 1001u);
+    for (std::uint32_t k = 0; k < 1000; ++k)
+      for (auto s = sort.offsets()[k]; s < sort.offsets()[k + 1]; ++s) ASSERT_EQ(keys[sort.order()[s]], k);
+  }
+}
+
+}  // namespace
