@@ -1,0 +1,114 @@
+#include "swirl/io/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <string>
+#include <system_error>
+
+#include <fmt/format.h>
+
+namespace swirl::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Distinguishes temporary names of concurrent writers within one process; the
+// pid does so across processes.
+std::atomic<unsigned long> g_counter{0};
+
+std::string errno_text(int err) { return std::generic_category().message(err); }
+
+[[noreturn]] void fail(const fs::path& path, std::string_view what, int err) {
+  throw IoError(fmt::format("{}: {}: {}", path.string(), what, errno_text(err)));
+}
+
+fs::path unique_sibling(const fs::path& path, std::string_view tag) {
+  return path.parent_path() /
+         fmt::format(".{}.{}.{}.{}", path.filename().string(), tag, ::getpid(), g_counter.fetch_add(1));
+}
+
+// Owns a file descriptor and the temporary file behind it until release():
+// every early exit (throw) closes the descriptor and removes the file.
+class TempFile {
+ public:
+  explicit TempFile(fs::path p) : path_(std::move(p)) {}
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  ~TempFile() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!released_) ::unlink(path_.c_str());
+  }
+
+  int open() { return fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666); }
+  int close() {
+    int fd = fd_;
+    fd_ = -1;  // close() releases the descriptor even when it reports an error
+    return ::close(fd);
+  }
+  void release() { released_ = true; }
+  int fd() const { return fd_; }
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+  int fd_ = -1;
+  bool released_ = false;
+};
+
+void sync_directory(const fs::path& path) {
+  fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) fail(path, "written, but its directory cannot be opened to sync it", errno);
+  int rc = ::fsync(fd);
+  int err = errno;
+  ::close(fd);
+  // Some file systems cannot fsync a directory at all (EINVAL); the data are
+  // then as durable as that file system allows.
+  if (rc != 0 && err != EINVAL) fail(path, "written, but syncing its directory failed", err);
+}
+
+}  // namespace
+
+void write_file_atomic(const fs::path& path, std::string_view bytes, bool sync) {
+  if (path.filename().empty()) throw IoError(fmt::format("{}: not a file name", path.string()));
+  TempFile tmp(unique_sibling(path, "tmp"));
+  if (tmp.open() < 0) {
+    int err = errno;
+    fail(path, fmt::format("cannot create temporary file {}", tmp.path().string()), err);
+  }
+
+  const char* p = bytes.data();
+  std::size_t left = bytes.size();
+  while (left > 0) {
+    ssize_t n = ::write(tmp.fd(), p, left);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      fail(path, "write failed", errno);
+    }
+    p += n;
+    left -= static_cast<std::size_t>(n);
+  }
+  if (sync && ::fsync(tmp.fd()) != 0) fail(path, "fsync failed", errno);
+  // Delayed-allocation file systems may report ENOSPC or EIO only here.
+  if (tmp.close() != 0) fail(path, "close failed", errno);
+  if (::rename(tmp.path().c_str(), path.c_str()) != 0) fail(path, "cannot rename the temporary file over it", errno);
+  tmp.release();
+  if (sync) sync_directory(path);
+}
+
+void ensure_writable_directory(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw IoError(fmt::format("{}: cannot create directory: {}", dir.string(), ec.message()));
+
+  // Permission bits do not tell the whole story (read-only mounts, ACLs, root),
+  // so the only reliable test is to create a file.
+  TempFile probe(unique_sibling(dir / "probe", "writable"));
+  if (probe.open() < 0) fail(dir, "directory is not writable", errno);
+  if (probe.close() != 0) fail(dir, "directory is not writable (close failed)", errno);
+}
+
+}  // namespace swirl::io

@@ -1,0 +1,68 @@
+// Internal helpers of the io module: reading a whole file, a minimal XML tag
+// scanner for the files this module writes, and strict number parsing.
+#pragma once
+
+#include <charconv>
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+namespace swirl::io::detail {
+
+// A parse error; readers rethrow it as IoError prefixed with the file name.
+struct Malformed : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// The whole file; IoError if it cannot be read.
+std::string read_file(const std::filesystem::path& path);
+
+// Escapes text for use inside a double-quoted XML attribute.
+std::string xml_escape(std::string_view text);
+
+struct XmlTag {
+  std::string name;
+  std::vector<std::pair<std::string, std::string>> attributes;  // values unescaped
+  bool closing = false;       // </name>
+  bool self_closing = false;  // <name .../>
+
+  // The attribute's value, or nullptr if absent.
+  const std::string* find(std::string_view key) const;
+  // The attribute's value; Malformed if absent.
+  const std::string& get(std::string_view key) const;
+};
+
+// Yields the tags of a document one by one, skipping character data, the XML
+// declaration and comments. Throws Malformed on bad syntax; never reads past
+// the end of the text.
+class XmlScanner {
+ public:
+  explicit XmlScanner(std::string_view text) : text_(text) {}
+
+  // The next tag, or nullopt at the end of the text.
+  std::optional<XmlTag> next();
+  // Index just after the '>' of the last tag returned.
+  std::size_t position() const { return pos_; }
+
+ private:
+  std::string_view text_;
+  std::size_t pos_ = 0;
+};
+
+// Parses all of `text` as a number of type T; Malformed naming `what` otherwise.
+template <class T>
+T parse_number(std::string_view text, std::string_view what) {
+  T value{};
+  auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (text.empty() || ec != std::errc{} || end != text.data() + text.size())
+    throw Malformed(std::string(what) + ": invalid number '" + std::string(text.substr(0, 40)) + "'");
+  return value;
+}
+
+}  // namespace swirl::io::detail
