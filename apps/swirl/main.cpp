@@ -1,6 +1,7 @@
 // swirl: the command-line tool. The only place that knows about files and flags.
 //
 //   swirl run SCENE [--threads N] [--out DIR] [--steps N] [--set key=value]... [--summary-json FILE]
+//   swirl hash-stats SCENE [--set key=value]... [--steps N] [--threads N]
 //   swirl info
 //
 // Exit status: 0 done, 1 the run failed (blow-up, write error), 2 bad input.
@@ -17,7 +18,9 @@
 #include "cli.hpp"
 #include "swirl/config.hpp"
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
+#include "swirl/sim/hash_stats.hpp"
 #include "swirl/sim/run.hpp"
 
 namespace {
@@ -77,6 +80,37 @@ int run(const RunArgs& args) {
   return 0;
 }
 
+struct HashStatsArgs {
+  std::string scene;
+  std::vector<std::string> overrides;
+  std::uint64_t steps = 0;
+  int threads = 0;
+};
+
+// Table 5.2 of the thesis, beside this run's figures.
+int hash_stats(const HashStatsArgs& args) {
+  const auto scene = swirl::scene::load_scene(args.scene, args.overrides);
+  if (args.threads > 0) swirl::parallel::set_thread_count(args.threads);
+  const auto s = swirl::sim::scene_hash_statistics(scene, args.steps);
+  fmt::print("hash-stats: {}: {} particles, h = {} m, {} mean neighbours{}\n", scene.file, s.particles,
+             scene.sph->smoothing_length, s.mean_neighbors(),
+             args.steps ? fmt::format(", after {} steps", args.steps) : std::string(" (initial positions)"));
+  fmt::print("  {:<52} {:>14} {:>30}\n", "", "swirl", "thesis, Table 5.2 (N = 15000)");
+  fmt::print("  {:<52} {:>14} {:>30}\n", "Hash table size", s.buckets, "24001 (1.6x particles)");
+  fmt::print("  {:<52} {:>13.1f}% {:>30}\n", "Empty hash buckets (of all buckets)", 100 * s.empty_fraction(), "89%");
+  fmt::print("  {:<52} {:>13.1f}% {:>30}\n", "Hash buckets with collisions (of non-empty buckets)",
+             100 * s.collision_fraction(), "5%");
+  fmt::print("  {:<52} {:>14.2f} {:>30}\n", "Avg. particles in each non-empty bucket", s.particles_per_nonempty_bucket(),
+             "5.94");
+  fmt::print("  {:<52} {:>13.1f}% {:>30}\n", "Redundant neighbour tests due to hash collisions",
+             100 * s.redundant_test_fraction(), "13%");
+  fmt::print("  {:<52} {:>13.2f}% {:>30}\n", "Duplicate interactions due to hash collisions", 100 * s.duplicate_fraction(),
+             "0.2%");
+  fmt::print("  counts: {} tests, {} redundant, {} interactions, {} duplicates with the check off\n", s.tests,
+             s.redundant_tests, s.interactions, s.duplicate_interactions);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -96,6 +130,13 @@ int main(int argc, char** argv) {
       ->type_name("KEY=VALUE");
   run_cmd->add_option("--summary-json", args.summary_json, "Also write the closing summary as JSON to FILE");
 
+  HashStatsArgs hs;
+  auto* hash_cmd = app.add_subcommand("hash-stats", "Print the spatial hash statistics of an SPH scene (Table 5.2)");
+  hash_cmd->add_option("scene", hs.scene, "Scene file (TOML) with an [sph] section")->required();
+  hash_cmd->add_option("--set", hs.overrides, "Override a scene key")->type_name("KEY=VALUE");
+  hash_cmd->add_option("--steps", hs.steps, "Run N steps before measuring (default: the initial positions)");
+  hash_cmd->add_option("--threads,-t", hs.threads, "Threads")->check(CLI::PositiveNumber);
+
   app.add_subcommand("info", "Print version, build and machine facts");
 
   try {
@@ -106,6 +147,7 @@ int main(int argc, char** argv) {
 
   try {
     if (app.got_subcommand("info")) return print_info();
+    if (app.got_subcommand("hash-stats")) return hash_stats(hs);
     return run(args);
   } catch (const swirl::scene::SceneError& e) {
     fmt::print(stderr, "swirl: error: {}\n", e.what());

@@ -35,6 +35,7 @@ std::string summary_text(const sim::RunSummary& s) {
   out += fmt::format("  threads          {}\n", s.threads);
   out += fmt::format("  bytes/particle   {}\n", s.bytes_per_particle);
   out += fmt::format("  frames           {} in {}\n", s.frames, s.out_dir.string());
+  for (const auto& [name, value] : s.metrics) out += fmt::format("  {:<16} {:.6g}\n", name, value);
   out += "  time per phase  ";
   for (const auto& [name, seconds] : s.phases)
     out += fmt::format(" {} {:.3f} s ({:.0f}%)", name, seconds, s.wall_seconds > 0 ? 100 * seconds / s.wall_seconds : 0.0);
@@ -43,7 +44,8 @@ std::string summary_text(const sim::RunSummary& s) {
 }
 
 std::string summary_json(const sim::RunSummary& s) {
-  std::string phases;
+  std::string phases, metrics;
+  for (const auto& [name, value] : s.metrics) metrics += fmt::format("  {}: {:.9g},\n", json_string(name), value);
   for (const auto& [name, seconds] : s.phases)
     phases += fmt::format("{}{}: {:.9g}", phases.empty() ? "" : ", ", json_string(name), seconds);
   return fmt::format(
@@ -51,9 +53,9 @@ std::string summary_json(const sim::RunSummary& s) {
       "  \"scene\": {},\n  \"precision\": {},\n  \"out_dir\": {},\n  \"threads\": {},\n"
       "  \"particles\": {},\n  \"steps\": {},\n  \"sim_time\": {:.17g},\n  \"wall_seconds\": {:.9g},\n"
       "  \"steps_per_second\": {:.9g},\n  \"phase_seconds\": {{{}}},\n  \"bytes_per_particle\": {},\n"
-      "  \"frames\": {},\n  \"completed\": {},\n  \"error\": {}\n}}\n",
+      "  \"frames\": {},\n{}  \"completed\": {},\n  \"error\": {}\n}}\n",
       json_string(s.scene_file), json_string(s.precision), json_string(s.out_dir.string()), s.threads, s.particles,
-      s.steps, s.sim_time, s.wall_seconds, s.steps_per_second, phases, s.bytes_per_particle, s.frames,
+      s.steps, s.sim_time, s.wall_seconds, s.steps_per_second, phases, s.bytes_per_particle, s.frames, metrics,
       s.error.empty() ? "true" : "false", s.error.empty() ? "null" : json_string(s.error));
 }
 

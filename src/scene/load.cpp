@@ -9,6 +9,7 @@
 #include <iterator>
 #include <limits>
 #include <memory>
+#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +18,7 @@
 #include <toml++/toml.h>
 
 #include "sources.hpp"
+#include "swirl/sph/lattice_mass.hpp"
 
 namespace swirl::scene {
 namespace {
@@ -25,7 +27,7 @@ using Keys = std::span<const std::string_view>;
 
 // The schema: the keys each table may hold. Everything else is refused, with a
 // suggestion, so a misspelt optional key cannot silently fall back to its default.
-constexpr std::string_view kSections[] = {"simulation", "box", "forces", "output", "particles"};
+constexpr std::string_view kSections[] = {"simulation", "box", "forces", "output", "particles", "sph", "random_box"};
 constexpr std::string_view kSimulationKeys[] = {"precision", "dt", "end_time", "steps", "block_size"};
 constexpr std::string_view kBoxKeys[] = {"min", "max", "restitution"};
 constexpr std::string_view kForcesKeys[] = {"gravity"};
@@ -33,10 +35,18 @@ constexpr std::string_view kOutputKeys[] = {"interval", "format"};
 constexpr std::string_view kLatticeKeys[] = {"kind", "min", "max", "spacing", "jitter", "seed", "mass", "velocity"};
 constexpr std::string_view kRandomKeys[] = {"kind", "min", "max", "count", "seed", "mass", "velocity"};
 constexpr std::string_view kListKeys[] = {"kind", "positions", "velocities", "mass", "masses"};
+constexpr std::string_view kFluidBlockKeys[] = {"kind", "min", "max", "spacing", "jitter", "seed", "velocity"};
+constexpr std::string_view kSphKeys[] = {"smoothing_length", "neighbours", "rest_density",      "sound_speed",
+                                         "viscosity",        "pressure",   "negative_pressure", "hash"};
+constexpr std::string_view kHashKeys[] = {"buckets", "duplicate_check"};
+constexpr std::string_view kPressureForms[] = {"thesis", "consistent"};  // the order of sph::PressureForm
+constexpr std::string_view kNegativePressures[] = {"keep", "zero"};      // the order of sph::NegativePressure
+constexpr std::string_view kRandomBoxKeys[] = {"neighbours", "seed"};
 constexpr std::string_view kSourceKeys[] = {"kind", "min",      "max",   "spacing",   "jitter",     "seed",
                                             "mass", "velocity", "count", "positions", "velocities", "masses"};
-constexpr std::string_view kKinds[] = {"lattice", "random", "list"};  // the order of ParticleSource
-constexpr Keys kKindKeys[] = {kLatticeKeys, kRandomKeys, kListKeys};
+// The first three in the order of ParticleSource; a fluid block is a lattice.
+constexpr std::string_view kKinds[] = {"lattice", "random", "list", "fluid_block"};
+constexpr Keys kKindKeys[] = {kLatticeKeys, kRandomKeys, kListKeys, kFluidBlockKeys};
 constexpr std::string_view kPrecisions[] = {"float", "double"};       // the order of Precision
 constexpr std::string_view kFormats[] = {"vtp", "csv"};               // the order of OutputFormat
 
@@ -238,6 +248,14 @@ class Table {
     return i->get();
   }
 
+  bool boolean(std::string_view k, bool fallback) const {
+    const auto* node = find(k);
+    if (!node) return fallback;
+    const auto* b = node->as_boolean();
+    if (!b) r_.wrong_type(key(k), "a boolean (true or false)", *node);
+    return b->get();
+  }
+
   Vec3d vec3(std::string_view k, std::optional<Vec3d> fallback = {}) const {
     if (!find(k) && fallback) return *fallback;
     return r_.vec3(need(k), key(k));
@@ -322,13 +340,21 @@ void read_output(const Table& t, Scene& s) {
 
 std::uint64_t read_seed(const Table& t) { return static_cast<std::uint64_t>(t.integer("seed", 1, 0)); }
 
-LatticeSource read_lattice(const Table& t, const Scene& s) {
+// A lattice; a fluid block (fluid = true) takes its mass from [sph].
+LatticeSource read_lattice(const Table& t, const Scene& s, bool fluid) {
   LatticeSource src;
   src.region = t.box(&s.box);
   src.spacing = t.number("spacing", {}, kPositive);
   src.jitter = t.number("jitter", 0.0, kJitter);
   src.seed = read_seed(t);
-  src.mass = t.number("mass", {}, kPositive);
+  if (fluid) {
+    if (!s.sph) t.fail("kind", "a 'fluid_block' needs an [sph] section (its mass comes from sph.rest_density)");
+    if (s.sph->smoothing_length / src.spacing > 1000)
+      t.fail("spacing", fmt::format("is over 1000 times smaller than sph.smoothing_length = {}", s.sph->smoothing_length));
+    src.mass = sph::lattice_mass_for_density(src.spacing, s.sph->smoothing_length, s.sph->rest_density);
+  } else {
+    src.mass = t.number("mass", {}, kPositive);
+  }
   src.velocity = t.vec3("velocity", Vec3d{});
   const auto n = detail::lattice_counts(src);
   for (int axis = 0; axis < 3; ++axis) {
@@ -390,6 +416,7 @@ ListSource read_list(const Table& t, const Scene& s) {
 
 void read_particles(const Table& top, Scene& s) {
   const Reader& r = top.reader();
+  if (s.random_box) return;  // its one source was made by read_random_box()
   const auto* node = top.find("particles");
   if (!node) r.fail("particles", "no particles: the scene needs at least one [[particles]] source");
   const auto& list = r.array(*node, "particles", "an array of tables ([[particles]])");
@@ -401,7 +428,7 @@ void read_particles(const Table& top, Scene& s) {
     t.only(kSourceKeys);  // first, so that a misspelt "kind" is reported as such
     const std::size_t kind = t.choice("kind", kKinds, {}, "kind");
     t.only(kKindKeys[kind], fmt::format("unknown key for kind '{}'", kKinds[kind]));
-    if (kind == 0) s.sources.emplace_back(read_lattice(t, s));
+    if (kind == 0 || kind == 3) s.sources.emplace_back(read_lattice(t, s, kind == 3));
     else if (kind == 1) s.sources.emplace_back(read_random(t, s));
     else s.sources.emplace_back(read_list(t, s));
     const std::uint64_t n = detail::source_count(s.sources.back());
@@ -416,6 +443,72 @@ void read_particles(const Table& top, Scene& s) {
                                     count_text(total), detail::kMaxParticles));
 }
 
+// [sph]. The smoothing length is given, or derived from a neighbour count and
+// the spacing of the first fluid block (volume per particle = spacing³).
+void read_sph(const Table& top, Scene& s) {
+  const Table t = top.table("sph");
+  if (!top.find("sph")) return;
+  t.only(kSphKeys);
+  sph::SphParameters p;
+  p.rest_density = t.number("rest_density", 1000.0, kPositive);
+  p.sound_speed = t.number("sound_speed", 10.0, kPositive);
+  p.viscosity = t.number("viscosity", 0.1, kNonNegative);
+  p.pressure_form = static_cast<sph::PressureForm>(t.choice("pressure", kPressureForms, 0, "pressure form"));
+  p.negative_pressure =
+      static_cast<sph::NegativePressure>(t.choice("negative_pressure", kNegativePressures, 0, "negative pressure rule"));
+  const Table hash = t.table("hash");
+  hash.only(kHashKeys);
+  p.buckets = static_cast<std::uint32_t>(hash.integer("buckets", 0, 0, 0xffffffffLL));
+  p.duplicate_check = hash.boolean("duplicate_check", true);
+  const bool has_h = t.find("smoothing_length") != nullptr, has_k = t.find("neighbours") != nullptr;
+  if (has_h && has_k) t.fail("neighbours", fmt::format("cannot be given together with {}", t.key("smoothing_length")));
+  if (has_h) {
+    p.smoothing_length = t.number("smoothing_length", {}, kPositive);
+  } else {
+    const double k = t.number("neighbours", {}, Range{0, 10000, true, false});
+    // The spacing of the first fluid block sets the volume per particle.
+    const auto* list = top.find("particles") ? top.find("particles")->as_array() : nullptr;
+    const toml::node* spacing = nullptr;
+    for (std::size_t i = 0; list && i < list->size() && !spacing; ++i) {
+      const auto* src = (*list)[i].as_table();
+      const auto* kind = src ? src->get("kind") : nullptr;
+      if (kind && kind->value<std::string>() == "fluid_block") spacing = src->get("spacing");
+    }
+    if (!spacing)
+      t.fail("neighbours", fmt::format("needs a [[particles]] source of kind 'fluid_block' to size h from "
+                                       "(or give {})", t.key("smoothing_length")));
+    const double s0 = t.reader().number(*spacing, "particles[].spacing", kPositive);
+    p.smoothing_length = sph::smoothing_length_for_neighbors(k, s0 * s0 * s0);
+  }
+  s.sph = p;
+}
+
+// [random_box] with the root key `particles` = N: the thesis's section 5 set-up.
+void read_random_box(const Table& top, Scene& s) {
+  if (!top.find("random_box")) return;
+  const Table t = top.table("random_box");
+  t.only(kRandomBoxKeys);
+  if (!s.sph) t.fail("neighbours", "a random box is sized from sph.smoothing_length: add an [sph] section");
+  if (top.table("box").find("min") || top.table("box").find("max"))
+    top.fail("box", "min and max are derived from the random box (L³ = N·(4/3)π h³ / k); remove them");
+  Scene::RandomBox rb;
+  rb.particles = static_cast<std::uint64_t>(
+      top.integer("particles", {}, 1, static_cast<std::int64_t>(detail::kMaxParticles)));
+  rb.neighbors = t.number("neighbours", 25.0, Range{0, 10000, true, false});
+  rb.seed = static_cast<std::uint64_t>(t.integer("seed", 1, 0));
+  const double h = s.sph->smoothing_length;
+  const double side =
+      std::cbrt(static_cast<double>(rb.particles) * 4.0 / 3.0 * std::numbers::pi * h * h * h / rb.neighbors);
+  s.box = {{0, 0, 0}, {side, side, side}};
+  RandomSource src;
+  src.region = s.box;
+  src.count = rb.particles;
+  src.seed = rb.seed;
+  src.mass = s.sph->rest_density * side * side * side / static_cast<double>(rb.particles);
+  s.sources.emplace_back(src);
+  s.random_box = rb;
+}
+
 Scene read_scene(const toml::table& root, std::string_view file) {
   const Reader r(file);
   const Table top(r, &root, "");
@@ -423,7 +516,15 @@ Scene read_scene(const toml::table& root, std::string_view file) {
   Scene s;
   s.file = std::string(file);
   read_simulation(top.table("simulation"), s);
-  read_box(top.table("box"), s);
+  read_sph(top, s);
+  if (top.find("random_box")) {
+    const Table box = top.table("box");
+    box.only(kBoxKeys);
+    s.restitution = box.number("restitution", 0.5, kUnit);
+    read_random_box(top, s);
+  } else {
+    read_box(top.table("box"), s);
+  }
   const Table forces = top.table("forces");
   forces.only(kForcesKeys);
   s.gravity = forces.vec3("gravity", s.gravity);
@@ -533,6 +634,17 @@ std::string canonical_text(const Scene& s) {
   for (std::size_t i = 0; i < s.formats.size(); ++i)
     put("{}\"{}\"", i ? ", " : "", kFormats[static_cast<std::size_t>(s.formats[i])]);
   put("]\n");
+  if (s.sph) {
+    put("[sph]\nsmoothing_length = {:.17g}\nrest_density = {:.17g}\nsound_speed = {:.17g}\nviscosity = {:.17g}\n",
+        s.sph->smoothing_length, s.sph->rest_density, s.sph->sound_speed, s.sph->viscosity);
+    put("pressure = \"{}\"\nnegative_pressure = \"{}\"\nhash = {{ buckets = {}, duplicate_check = {} }}\n",
+        kPressureForms[static_cast<std::size_t>(s.sph->pressure_form)],
+        kNegativePressures[static_cast<std::size_t>(s.sph->negative_pressure)], s.sph->buckets,
+        s.sph->duplicate_check);
+  }
+  if (s.random_box)
+    put("[random_box]\nparticles = {}\nneighbours = {:.17g}\nseed = {}\n", s.random_box->particles,
+        s.random_box->neighbors, s.random_box->seed);
   for (const auto& source : s.sources) {
     if (const auto* l = std::get_if<LatticeSource>(&source)) {
       put("[[particles]]\nkind = \"lattice\"\nmin = {}\nmax = {}\nspacing = {:.17g}\njitter = {:.17g}\nseed = {}\n",

@@ -6,14 +6,13 @@
 
 #include <fmt/format.h>
 
-#include "swirl/force/uniform_gravity.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/csv.hpp"
 #include "swirl/io/pvd.hpp"
 #include "swirl/io/vtp.hpp"
 #include "swirl/parallel/for_blocks.hpp"
-#include "swirl/scene/initial_conditions.hpp"
-#include "swirl/sim/simulation.hpp"
+#include "swirl/sim/build.hpp"
+#include "swirl/sph/diagnostics.hpp"
 
 namespace swirl::sim {
 namespace {
@@ -46,6 +45,22 @@ class FrameWriter {
   std::size_t frames_ = 0;
 };
 
+// A CSV file with one row per output time, rewritten atomically after each row
+// so that it always holds every row so far.
+class CsvLog {
+ public:
+  CsvLog(std::filesystem::path path, std::string header) : path_(std::move(path)), text_(std::move(header) + "\n") {}
+  void add(const std::vector<double>& row) {
+    for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
+    text_ += "\n";
+    io::write_file_atomic(path_, text_);
+  }
+
+ private:
+  std::filesystem::path path_;
+  std::string text_;
+};
+
 template <class Real>
 std::size_t bytes_per_particle(const ParticleSet<Real>& p) {
   std::size_t bytes = sizeof(std::uint64_t);  // id
@@ -62,12 +77,14 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   summary.out_dir = options.out_dir;
   summary.threads = parallel::thread_count();
 
-  SimulationSettings settings;
-  settings.dt = scene.dt;
-  settings.block_size = scene.block_size;
-  settings.box = boundary::BoxCollision<double>{scene.box, scene.restitution};
-  Simulation<Real> sim(scene::make_particles<Real>(scene), settings);
-  sim.add_force(std::make_unique<UniformGravity<Real>>(scene.gravity.template cast<Real>()));
+  auto built = build_simulation<Real>(scene);
+  Simulation<Real>& sim = built.sim;
+  const sph::SphFluid<Real>* fluid = built.fluid;
+  std::optional<CsvLog> diagnostics;
+  if (fluid)
+    diagnostics.emplace(options.out_dir / "diagnostics.csv",
+                        "time,kinetic_energy,potential_energy,momentum_x,momentum_y,momentum_z,"
+                        "mean_density_error,max_density_error,mean_neighbours");
   summary.particles = sim.particles().size();
   summary.bytes_per_particle = bytes_per_particle(sim.particles());
 
@@ -78,7 +95,13 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   auto write_frame = [&] {
     ScopedPhase phase(sim.timers(), "output");
     writer.write(sim.particles(), sim.time());
+    if (diagnostics) {
+      const auto d = sph::fluid_diagnostics(sim.particles(), scene.gravity, scene.sph->rest_density, scene.block_size);
+      diagnostics->add({sim.time(), d.kinetic_energy, d.potential_energy, d.momentum.x, d.momentum.y, d.momentum.z,
+                        d.mean_density_error, d.max_density_error, fluid->mean_neighbors()});
+    }
   };
+  double neighbor_sum = 0;  // of the per-evaluation means, for the summary
 
   // Frame k is due at the first step with time ≥ k·interval; the slack keeps
   // k·interval that lands on a step (up to rounding) on that step.
@@ -92,6 +115,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   try {
     for (std::uint64_t s = 0; s < total; ++s) {
       sim.step();
+      if (fluid) neighbor_sum += fluid->mean_neighbors();
       last_written = false;
       if (interval > 0 && sim.time() + slack >= static_cast<double>(next_frame) * interval) {
         write_frame();
@@ -113,6 +137,10 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   summary.steps_per_second = summary.wall_seconds > 0 ? static_cast<double>(summary.steps) / summary.wall_seconds : 0;
   summary.phases = sim.timers().phases();
   summary.frames = writer.frames();
+  if (fluid) {
+    const double evaluations = static_cast<double>(summary.steps);
+    summary.metrics.emplace_back("mean_neighbours", evaluations > 0 ? neighbor_sum / evaluations : fluid->mean_neighbors());
+  }
   return summary;
 }
 

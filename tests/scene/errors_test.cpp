@@ -158,7 +158,7 @@ TEST(SceneErrors, ConflictsAndLengths) {
 TEST(SceneErrors, UnknownNamesListTheAllowedOnes) {
   for (const Case& c : std::vector<Case>{
            {"kind", full("kind = \"random\"", "kind = \"grid\""),
-            "particles[1].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list')"},
+            "particles[1].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list', 'fluid_block')"},
            {"precision", full("precision = \"double\"", "precision = \"single\""),
             "simulation.precision: unknown precision 'single' (allowed: 'float', 'double')"},
            {"format", full("format = [\"csv\", \"vtp\"]", "format = \"xml\""),

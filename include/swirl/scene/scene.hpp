@@ -16,6 +16,7 @@
 
 #include "swirl/core/box.hpp"
 #include "swirl/core/vec3.hpp"
+#include "swirl/sph/parameters.hpp"
 
 namespace swirl::scene {
 
@@ -70,7 +71,22 @@ struct Scene {
   double output_interval = 0;              // output.interval, s of simulated time; 0 = first and last frame only
   std::vector<OutputFormat> formats{OutputFormat::Vtp};  // output.format: "vtp" and/or "csv"
 
-  std::vector<ParticleSource> sources;     // [[particles]]
+  std::vector<ParticleSource> sources;     // [[particles]]; a "fluid_block" becomes a LatticeSource
+                                           // whose mass gives the rest density (sph::lattice_mass_for_density)
+
+  // [sph]: present for fluid scenes. smoothing_length is resolved (given, or
+  // from sph.neighbours and the first fluid block's spacing).
+  std::optional<sph::SphParameters> sph;
+
+  // [random_box]: the thesis's benchmark set-up (section 5), when present: N =
+  // `particles` random particles in the box [0, L]³ with L³ = N·(4/3)π h³ / k,
+  // each of mass ρ0·L³/N; the box and a RandomSource are derived from it.
+  struct RandomBox {
+    std::uint64_t particles = 0;   // N (root key `particles`)
+    double neighbors = 25;         // k (random_box.neighbours)
+    std::uint64_t seed = 1;        // random_box.seed
+  };
+  std::optional<RandomBox> random_box;
 
   // Number of steps the scene asks for: `steps`, or ceil(end_time / dt) (a step
   // that would overshoot end_time by less than 1e-9·dt is not added).

@@ -6,7 +6,8 @@
 // particles.pvd listing the .vtp frames with their times; every file is
 // written atomically. Frame k is written at the first step whose time is
 // ≥ k·output.interval, the initial state is frame 0, and the final state is
-// always written.
+// always written. SPH runs also write diagnostics.csv: one row per frame with
+// kinetic and potential energy, momentum, density errors and mean neighbours.
 #pragma once
 
 #include <cstddef>
@@ -49,6 +50,8 @@ struct RunSummary {
   std::vector<std::pair<std::string, double>> phases;  // seconds per phase
   std::size_t bytes_per_particle = 0;   // particle storage (all fields and ids) / particles
   std::size_t frames = 0;               // frames written
+  // Solver figures, e.g. {"mean_neighbours", 24.9} for SPH runs (mean over steps).
+  std::vector<std::pair<std::string, double>> metrics;
   std::string error;                    // empty when the run completed
 };
 

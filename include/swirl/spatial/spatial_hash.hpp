@@ -72,7 +72,9 @@ class SpatialHash {
     sort_.sort(hashes_, buckets);
     const auto& order = sort_.order();
     for (int axis = 0; axis < 3; ++axis) sorted_position_[axis].resize(n);
+    sorted_cells_.resize(n);
     parallel::for_blocks("fill_table", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t slot = b; slot < e; ++slot) sorted_cells_[slot] = cells_[order[slot]];
       for (int axis = 0; axis < 3; ++axis) {
         const Real* x = p.position[axis].data();
         Real* s = sorted_position_[axis].data();
@@ -108,7 +110,7 @@ class SpatialHash {
       for (std::size_t row = first; row < last; ++row) {
         const std::uint32_t i = order[row];
         const Real xi = sorted_position_[0][row], yi = sorted_position_[1][row], zi = sorted_position_[2][row];
-        const Cell ci = cells_[i];
+        const Cell ci = sorted_cells_[row];
         const std::size_t row_begin = list.neighbor.size();
         for (int dk = -1; dk <= 1; ++dk)
           for (int dj = -1; dj <= 1; ++dj)
@@ -116,9 +118,8 @@ class SpatialHash {
               const Cell c{wrap(ci.i, di), wrap(ci.j, dj), wrap(ci.k, dk)};
               const std::uint32_t b = hash_cell(c, buckets);
               for (std::uint32_t s = offsets[b]; s < offsets[b + 1]; ++s) {
-                const std::uint32_t j = order[s];
-                if (j == i) continue;
-                const bool same_cell = cells_[j] == c;
+                if (s == row) continue;  // the particle itself
+                const bool same_cell = sorted_cells_[s] == c;
                 if (counters) {
                   ++local.tests;
                   local.redundant_tests += same_cell ? 0 : 1;
@@ -127,7 +128,7 @@ class SpatialHash {
                 const Real r2 = distance2(xi, yi, zi, sorted_position_[0][s], sorted_position_[1][s],
                                           sorted_position_[2][s]);
                 if (within(r2, h2)) {
-                  list.neighbor.push_back(j);
+                  list.neighbor.push_back(order[s]);
                   list.r2.push_back(r2);
                 }
               }
@@ -190,7 +191,8 @@ class SpatialHash {
   std::vector<Cell> cells_;
   std::vector<std::uint32_t> hashes_;
   parallel::CountingSort sort_;
-  std::array<std::vector<Real>, 3> sorted_position_;
+  std::array<std::vector<Real>, 3> sorted_position_;  // positions in slot order, as the thesis's table holds them
+  std::vector<Cell> sorted_cells_;                     // cells in slot order, for the cell-relation check
   std::vector<BlockList> block_lists_;  // kept between searches to avoid reallocation
 };
 

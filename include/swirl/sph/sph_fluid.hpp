@@ -7,11 +7,27 @@
 //     (Algorithm 4)                                              ("forces.search")
 //        ρ_i = Σ_j m_j W_poly6(r_ij) + m_i W_poly6(0)             (eq. 2.3, 2.11)
 //        p_i = c² (ρ_i − ρ0)                                       (eq. 2.9)
+//              (or max(0, ·) with NegativePressure::Zero, see below)
 //  3. sums the forces over the lists (Algorithm 5)                ("forces.sph")
 //        f_i = −Σ_j m_j (p_i + p_j) / (2 ρ_j) ∇W_spiky(r_ij)        (eq. 2.8)
+//              (or without the ½ with PressureForm::Consistent, see below)
 //            + μ Σ_j m_j (v_j − v_i) / ρ_j ∇²W_viscosity(r_ij)      (eq. 2.10)
 //        a_i += f_i / ρ_i                                          (eq. 2.6)
 // External forces (gravity) are separate force models (eq. 2.7).
+//
+// Eq. 2.8 (Müller et al. 2003's symmetrisation) estimates only half of ∇p:
+// on a lattice Σ_j V_j ½(p_i + p_j) ∇W_ij = ½ Σ_j V_j p_j ∇W_ij = ½ ∇p, because
+// Σ_j V_j ∇W_ij vanishes. A fluid run with it behaves as if its pressure were
+// p/2, and in hydrostatic equilibrium dp/dz = 2 ρ0 g (tested). That is the
+// thesis's physics and the default; PressureForm::Consistent drops the ½, so
+// that p is the physical pressure (equivalent to the thesis's with c² doubled).
+//
+// Eq. 2.9 lets pressure go negative where a free surface or a wall leaves a
+// particle short of neighbours; with the mixed kernels (poly6 density, spiky
+// force) that tension is not energy-conserving, and a free drop clumps into
+// groups of particles at rest density and falls apart (seen in tests; the
+// "tensile instability"). NegativePressure::Zero clamps it, as many graphics
+// codes do; the default keeps the thesis's equation.
 //
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
 // Every pass gathers into particle i only: deterministic for any thread count.
@@ -22,6 +38,7 @@
 #include <optional>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -29,24 +46,10 @@
 #include "swirl/force/force_model.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sph/kernels.hpp"
+#include "swirl/sph/parameters.hpp"
 #include "swirl/spatial/spatial_hash.hpp"
 
 namespace swirl::sph {
-
-struct SphParameters {
-  double smoothing_length = 0;     // h, m (> 0): kernel support and hash cell length
-  double rest_density = 1000;      // ρ0, kg/m³
-  double sound_speed = 10;         // c, m/s
-  double viscosity = 0.1;          // μ, Pa·s (≥ 0)
-  std::uint32_t buckets = 0;       // hash table size M; 0 = the thesis's ≈ 1.6·N (made odd)
-  bool duplicate_check = true;     // the cell-relation check of section 4.2.3
-};
-
-// The thesis's table size for n particles: 1.6·n, odd (24001 for 15000).
-inline std::uint32_t default_bucket_count(std::size_t n) {
-  const auto m = static_cast<std::uint64_t>(1.6 * static_cast<double>(n));
-  return static_cast<std::uint32_t>(std::min<std::uint64_t>(m | 1u, 0xffffffffu));
-}
 
 template <class Real>
 class SphFluid final : public ForceModel<Real> {
@@ -72,6 +75,8 @@ class SphFluid final : public ForceModel<Real> {
       PhaseScope phase(ctx, "forces.search");
       const Poly6<Real> w(h);
       const Real w0 = w(Real(0)), rho0 = Real(params_.rest_density);
+      const Real floor = params_.negative_pressure == NegativePressure::Zero ? Real(0)
+                                                                              : -std::numeric_limits<Real>::infinity();
       const Real c2 = Real(params_.sound_speed * params_.sound_speed);
       const Real* m = p.mass.data();
       Real* rho = p.density.data();
@@ -81,7 +86,7 @@ class SphFluid final : public ForceModel<Real> {
                              Real sum = m[i] * w0;
                              for (std::size_t k = 0; k < count; ++k) sum += m[nb[k]] * w(r2[k]);
                              rho[i] = sum;
-                             pressure[i] = c2 * (sum - rho0);
+                             pressure[i] = std::max(floor, c2 * (sum - rho0));
                            });
     }
     {
@@ -112,6 +117,7 @@ class SphFluid final : public ForceModel<Real> {
     const Spiky<Real> spiky(Real(params_.smoothing_length));
     const Viscosity<Real> visc(Real(params_.smoothing_length));
     const Real mu = Real(params_.viscosity);
+    const Real half = params_.pressure_form == PressureForm::Thesis ? Real(0.5) : Real(1);
     const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
     const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
     const Real *m = p.mass.data(), *rho = p.density.data(), *pr = p.pressure.data();
@@ -126,7 +132,7 @@ class SphFluid final : public ForceModel<Real> {
           const Real r = std::sqrt(L.r2[k]);
           const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
           // Pressure (eq. 2.8) along r⃗ = x_i − x_j, and viscosity (eq. 2.10).
-          const Real fp = -m[j] * (pr[i] + pr[j]) / (Real(2) * rho[j]) * spiky.gradient_factor(r);
+          const Real fp = -m[j] * (pr[i] + pr[j]) * half / rho[j] * spiky.gradient_factor(r);
           const Real fv = mu * m[j] / rho[j] * visc.laplacian(r);
           fx += fp * dx + fv * (vx[j] - vx[i]);
           fy += fp * dy + fv * (vy[j] - vy[i]);

@@ -1,0 +1,39 @@
+// Building the Simulation a scene describes: its particles, its box and its
+// force models (SPH when the scene has [sph], uniform gravity when non-zero).
+// Shared by run_scene() and the tools that inspect a scene (hash-stats).
+#pragma once
+
+#include <memory>
+
+#include "swirl/force/uniform_gravity.hpp"
+#include "swirl/scene/initial_conditions.hpp"
+#include "swirl/scene/scene.hpp"
+#include "swirl/sim/simulation.hpp"
+#include "swirl/sph/sph_fluid.hpp"
+
+namespace swirl::sim {
+
+template <class Real>
+struct SceneSimulation {
+  Simulation<Real> sim;
+  sph::SphFluid<Real>* fluid = nullptr;  // owned by sim; null without [sph]
+};
+
+template <class Real>
+SceneSimulation<Real> build_simulation(const scene::Scene& scene) {
+  SimulationSettings settings;
+  settings.dt = scene.dt;
+  settings.block_size = scene.block_size;
+  settings.box = boundary::BoxCollision<double>{scene.box, scene.restitution};
+  SceneSimulation<Real> out{Simulation<Real>(scene::make_particles<Real>(scene), settings), nullptr};
+  if (scene.sph) {
+    auto model = std::make_unique<sph::SphFluid<Real>>(*scene.sph);
+    out.fluid = model.get();
+    out.sim.add_force(std::move(model));
+  }
+  if (!(scene.gravity == Vec3d{}))
+    out.sim.add_force(std::make_unique<UniformGravity<Real>>(scene.gravity.template cast<Real>()));
+  return out;
+}
+
+}  // namespace swirl::sim

@@ -1,0 +1,38 @@
+// Particle mass for fluid on a simple cubic lattice, and the smoothing length
+// for a target neighbour count.
+#pragma once
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "swirl/sph/kernels.hpp"
+
+namespace swirl::sph {
+
+// The mass m that makes the SPH density of an interior particle of a simple
+// cubic lattice of spacing s exactly ρ0: m = ρ0 / Σ_n W_poly6(|n|·s, h), the sum
+// over all lattice vectors n (the particle itself included) within h. A block
+// made with it starts at rest with zero pressure inside.
+inline double lattice_mass_for_density(double spacing, double h, double rest_density) {
+  if (!(spacing > 0) || !(h > 0) || !(rest_density > 0) || h / spacing > 1000)
+    throw std::invalid_argument("lattice mass: need spacing > 0, h > 0, ρ0 > 0 and h/spacing ≤ 1000");
+  const Poly6<double> w(h);
+  const int reach = static_cast<int>(std::ceil(h / spacing));
+  double sum = 0;
+  for (int i = -reach; i <= reach; ++i)
+    for (int j = -reach; j <= reach; ++j)
+      for (int k = -reach; k <= reach; ++k) sum += w(spacing * spacing * double(i * i + j * j + k * k));
+  return rest_density / sum;
+}
+
+// The h whose ball holds k neighbours on average when each particle occupies
+// volume v: (4/3)π h³ = (k + 1)·v counts the particle itself, so
+// h = (3 (k + 1) v / (4π))^(1/3). Self is not a neighbour (section 4.2).
+inline double smoothing_length_for_neighbors(double neighbors, double volume_per_particle) {
+  if (!(neighbors > 0) || !(volume_per_particle > 0))
+    throw std::invalid_argument("smoothing length: need neighbours > 0 and a positive particle volume");
+  return std::cbrt(3.0 * (neighbors + 1.0) * volume_per_particle / (4.0 * std::numbers::pi));
+}
+
+}  // namespace swirl::sph

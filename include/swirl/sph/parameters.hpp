@@ -1,0 +1,40 @@
+// Parameters of the SPH fluid (sph_fluid.hpp), in SI units.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+
+namespace swirl::sph {
+
+// Which symmetrisation of the pressure force (see sph_fluid.hpp: eq. 2.8
+// estimates only half of ∇p).
+enum class PressureForm {
+  Thesis,      // (p_i + p_j) / (2 ρ_j): eq. 2.8, Müller et al. 2003
+  Consistent,  // (p_i + p_j) / ρ_j: a consistent estimate of ∇p
+};
+
+// What the equation of state does below the rest density (sph_fluid.hpp).
+enum class NegativePressure {
+  Keep,  // p = c² (ρ − ρ0) as eq. 2.9: the fluid resists stretching (tension)
+  Zero,  // p = max(0, c² (ρ − ρ0)): no tension, so free surfaces do not clump
+};
+
+struct SphParameters {
+  double smoothing_length = 0;     // h, m (> 0): kernel support and hash cell length
+  double rest_density = 1000;      // ρ0, kg/m³
+  double sound_speed = 10;         // c, m/s
+  double viscosity = 0.1;          // μ, Pa·s (≥ 0)
+  std::uint32_t buckets = 0;       // hash table size M; 0 = the thesis's ≈ 1.6·N (made odd)
+  bool duplicate_check = true;     // the cell-relation check of section 4.2.3
+  PressureForm pressure_form = PressureForm::Thesis;
+  NegativePressure negative_pressure = NegativePressure::Keep;
+};
+
+// The thesis's table size for n particles: 1.6·n, odd (24001 for 15000).
+inline std::uint32_t default_bucket_count(std::size_t n) {
+  const auto m = static_cast<std::uint64_t>(1.6 * static_cast<double>(n));
+  return static_cast<std::uint32_t>(std::min<std::uint64_t>(m | 1u, 0xffffffffu));
+}
+
+}  // namespace swirl::sph
