@@ -8,7 +8,7 @@
 
 PRESET   ?= release
 JOBS     ?= $(shell nproc)
-DEMO     ?= examples/falling_block.toml
+DEMO     ?= examples/dam_break.toml
 DEMO_OUT ?= out/demo
 
 # Debian 12 packages needed to build and test swirl.

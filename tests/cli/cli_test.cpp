@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -151,6 +152,40 @@ TEST_F(Cli, AnUnwritableOutputDirectoryIsRefusedBeforeRunning) {
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("file/sub"), std::string::npos) << r.err;
   EXPECT_EQ(r.out.find("steps per second"), std::string::npos);
+}
+
+TEST_F(Cli, RandomBoxReportsNeighboursAndWritesDiagnostics) {
+  const std::string scene = std::string(SWIRL_SOURCE_DIR) + "/examples/random_box.toml";
+  const auto out = dir_ / "rb";
+  const auto json = dir_ / "rb.json";
+  const auto r = swirl("run " + scene + " --set particles=3000 --steps 4 --threads 2 --out " + out.string() +
+                       " --summary-json " + json.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("mean_neighbours"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("particles        3000"), std::string::npos) << r.out;
+  const std::string summary = slurp(json);
+  const auto at = summary.find("\"mean_neighbours\": ");
+  ASSERT_NE(at, std::string::npos) << summary;
+  const double neighbours = std::stod(summary.substr(at + 19));
+  EXPECT_GT(neighbours, 18.0);  // 25 targeted; particles near the walls have fewer
+  EXPECT_LT(neighbours, 27.0);
+  // One diagnostics row per frame (t = 0 and the end), after the header.
+  const std::string csv = slurp(out / "diagnostics.csv");
+  EXPECT_EQ(csv.rfind("time,kinetic_energy", 0), 0u) << csv;
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;
+}
+
+TEST_F(Cli, HashStatsPrintsTable52) {
+  const std::string scene = std::string(SWIRL_SOURCE_DIR) + "/examples/random_box.toml";
+  auto r = swirl("hash-stats " + scene + " --set particles=3000");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* row : {"Hash table size", "Empty hash buckets", "collisions", "non-empty bucket", "Redundant",
+                          "Duplicate interactions", "4801"})
+    EXPECT_NE(r.out.find(row), std::string::npos) << row << "\n" << r.out;
+  const auto plain = write_scene("small.toml", kSmallScene);
+  r = swirl("hash-stats " + plain.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("[sph]"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, InfoNamesTheBuild) {
