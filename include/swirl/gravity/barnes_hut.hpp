@@ -1,0 +1,104 @@
+// BarnesHut<Real>: the paper's tree code with its parallel schemes (Demiroz et
+// al. 2011, sections 2 and 4), computing a GravityField for a ParticleSet.
+//
+// Which trees a particle walks (the approximation) is the paper's:
+//   global     one tree of all particles, walked from the root.
+//   subdomain  (4.1) particles sorted in Morton order of their positions in the
+//              bounding cube, cut into runs of ≤ subdomain_size particles by
+//              packing Morton cells greedily (the paper's 512 cells, grown
+//              adaptively); one local tree per run; every particle walks every
+//              local tree and its force is their sum.
+//   subtree    (4.2) one global tree, cut depth first into units of ≤
+//              subtree_nodes nodes, a unit being whole sub-trees packed in
+//              depth-first order; every particle walks every unit, its force is
+//              the sum over units. The paper copies the upper nodes into every
+//              local tree without saying how their mass avoids being counted
+//              twice; our reading: a node that straddles units (more than
+//              subtree_nodes nodes below it) is always opened, never used as a
+//              cluster, so every mass is counted exactly once.
+// Sub-domains and units depend on the particles and the sizes only, never on
+// the thread count.
+//
+// Who computes what: as on the Cell, a thread walks whole trees (units) for all
+// particles, the trees dealt heaviest first to the least loaded thread, by the
+// nodes each sub-domain's tree explored in the previous evaluation (4.1.1) or
+// by node count for units (4.2.1); global hands particle blocks to threads
+// dynamically. Determinism: each tree's contribution is summed per particle in
+// tree order, whatever thread computed it, so results are bit-identical for
+// any thread count (and the balance changes only who computes what).
+//
+// Units: G = 1; the softening and λ come from GravitySettings.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "swirl/core/particle_set.hpp"
+#include "swirl/gravity/field.hpp"
+#include "swirl/gravity/octree.hpp"
+#include "swirl/gravity/settings.hpp"
+
+namespace swirl::gravity {
+
+// What the last evaluation did.
+struct GravityStats {
+  double mean_nodes_visited = 0;  // nodes taken from visit lists per particle, over all trees it walked
+  std::size_t trees = 0;          // sub-domain trees, sub-tree units, or 1 (global); 0 for the direct sum
+  std::size_t nodes = 0;          // nodes built (sum over trees)
+  int depth = 0;                  // deepest tree level
+  double tree_build_seconds = 0;  // sorting, tree construction, cutting into units
+  double force_seconds = 0;       // walks and the per-particle sums
+};
+
+template <class Real>
+class BarnesHut {
+ public:
+  // Validates the settings (std::invalid_argument); settings.method is ignored.
+  explicit BarnesHut(const GravitySettings& settings);
+
+  // Overwrites out (resized to p.size()) with the tree field of p. block_size
+  // is the block of the per-particle passes (results do not depend on it).
+  void compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+
+  const GravitySettings& settings() const { return settings_; }
+  const GravityStats& stats() const { return stats_; }
+  // Nodes explored by all particles in each tree (unit) in the last
+  // evaluation: the load metric of section 4.1.1.
+  std::span<const std::uint64_t> work() const { return work_; }
+
+ private:
+  // A tree to walk, and the nodes its walk starts from.
+  struct Source {
+    std::uint32_t tree;
+    std::uint32_t entries_begin, entries_end;  // into entries_
+  };
+
+  void build_subdomains(const ParticleSet<Real>& p);
+  void build_global_tree(const ParticleSet<Real>& p);
+  void cut_units();
+  void walk_global(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  void walk_sources(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+                    const std::vector<std::uint64_t>& weights);
+  std::uint64_t walk_source(const ParticleSet<Real>& p, std::size_t s, GravityField<Real>& into) const;
+
+  GravitySettings settings_;
+  GravityStats stats_;
+  std::vector<Octree<Real>> trees_;
+  std::vector<Source> sources_;
+  std::vector<std::uint32_t> entries_;
+  std::vector<std::pair<std::size_t, std::size_t>> runs_;  // sub-domains: [begin, end) of order_
+  std::vector<std::uint32_t> order_;  // particles in walk order (Morton or leaf order)
+  std::vector<std::uint32_t> home_tree_, home_leaf_;  // the tree and leaf holding each particle
+  std::vector<std::uint64_t> work_, previous_work_;
+  std::vector<GravityField<Real>> buffers_;  // one tree's contribution per buffer
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keys_;
+  std::vector<std::uint32_t> identity_;
+};
+
+extern template class BarnesHut<float>;
+extern template class BarnesHut<double>;
+
+}  // namespace swirl::gravity

@@ -1,0 +1,53 @@
+// Timing the paper's experiment (section 5): a Plummer sphere of N particles,
+// `iterations` steps of force evaluation + leapfrog update, per phase: the
+// rows of the paper's Table 1 (tree construction, force calculation, update
+// positions) and the totals of its Table 2.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "swirl/gravity/settings.hpp"
+
+namespace swirl::gravity {
+
+struct BenchSettings {
+  Scheme scheme = Scheme::global;
+  Method method = Method::barnes_hut;
+  std::size_t n = 4096;
+  double opening = 0.5;          // λ (the paper's default)
+  int iterations = 50;           // the paper's default
+  int threads = 1;
+  double softening = 0.01;
+  double dt = 1.0 / 128;
+  std::uint64_t seed = 1;
+  bool single_precision = false;  // float instead of double
+};
+
+struct BenchResult {
+  // Seconds summed over the iterations (the initial force evaluation excluded).
+  double tree_build = 0;  // sorting, tree construction, cutting into units
+  double force = 0;       // walks and per-particle sums
+  double update = 0;      // drift and kick
+  double total = 0;       // whole steps, wall clock
+  double mean_nodes_visited = 0;  // per particle, last evaluation
+  std::size_t trees = 0;          // trees or units walked, last evaluation
+  std::size_t nodes = 0;          // nodes built, last evaluation
+};
+
+// Runs the experiment; restores the thread count afterwards. Throws
+// std::invalid_argument for bad settings.
+BenchResult time_iterations(const BenchSettings& settings);
+
+// The paper's experiment: λ, N, iterations and threads as given, in double.
+inline BenchResult time_iterations(Scheme scheme, std::size_t n, double opening, int iterations, int threads) {
+  BenchSettings s;
+  s.scheme = scheme;
+  s.n = n;
+  s.opening = opening;
+  s.iterations = iterations;
+  s.threads = threads;
+  return time_iterations(s);
+}
+
+}  // namespace swirl::gravity
