@@ -27,7 +27,17 @@ using Keys = std::span<const std::string_view>;
 
 // The schema: the keys each table may hold. Everything else is refused, with a
 // suggestion, so a misspelt optional key cannot silently fall back to its default.
-constexpr std::string_view kSections[] = {"simulation", "box", "forces", "output", "particles", "sph", "random_box"};
+constexpr std::string_view kSections[] = {"simulation", "box",        "forces", "output",
+                                          "particles",  "sph",        "random_box", "nbody"};
+constexpr std::string_view kNbodyKeys[] = {"method", "scheme", "opening", "softening", "subdomain_size", "subtree_nodes"};
+constexpr std::string_view kMethods[] = {"direct", "barnes_hut"};            // the order of gravity::Method
+constexpr std::string_view kSchemes[] = {"subdomain", "subtree", "global"};  // the order of gravity::Scheme
+constexpr std::string_view kPlummerKeys[] = {"kind", "count", "seed", "mass_cut", "offset", "velocity"};
+constexpr std::string_view kUniformSphereKeys[] = {"kind", "count", "seed", "radius", "mass", "offset", "velocity"};
+constexpr std::string_view kUniformCubeKeys[] = {"kind", "count", "seed", "side", "mass", "offset", "velocity"};
+constexpr std::string_view kColdCollapseKeys[] = {"kind", "count", "seed", "offset", "velocity"};
+constexpr std::string_view kCollisionKeys[] = {"kind",      "count",      "seed",     "mass_fraction", "separation",
+                                               "impact_parameter", "relative_velocity", "mass_cut", "offset", "velocity"};
 constexpr std::string_view kSimulationKeys[] = {"precision", "dt", "end_time", "steps", "block_size"};
 constexpr std::string_view kBoxKeys[] = {"min", "max", "restitution"};
 constexpr std::string_view kForcesKeys[] = {"gravity"};
@@ -42,11 +52,17 @@ constexpr std::string_view kHashKeys[] = {"buckets", "duplicate_check"};
 constexpr std::string_view kPressureForms[] = {"thesis", "consistent"};  // the order of sph::PressureForm
 constexpr std::string_view kNegativePressures[] = {"keep", "zero"};      // the order of sph::NegativePressure
 constexpr std::string_view kRandomBoxKeys[] = {"neighbours", "seed"};
-constexpr std::string_view kSourceKeys[] = {"kind", "min",      "max",   "spacing",   "jitter",     "seed",
-                                            "mass", "velocity", "count", "positions", "velocities", "masses"};
-// The first three in the order of ParticleSource; a fluid block is a lattice.
-constexpr std::string_view kKinds[] = {"lattice", "random", "list", "fluid_block"};
-constexpr Keys kKindKeys[] = {kLatticeKeys, kRandomKeys, kListKeys, kFluidBlockKeys};
+constexpr std::string_view kSourceKeys[] = {
+    "kind",     "min",    "max",    "spacing",  "jitter",        "seed",       "mass",
+    "velocity", "count",  "positions", "velocities", "masses",   "mass_cut",   "radius",
+    "side",     "offset", "mass_fraction", "separation", "impact_parameter", "relative_velocity"};
+// A fluid block is a lattice; the last five, from 4 on, are StellarSource models in
+// the order of StellarSource::Model.
+constexpr std::string_view kKinds[] = {"lattice",        "random",       "list",          "fluid_block", "plummer",
+                                       "uniform_sphere", "uniform_cube", "cold_collapse", "plummer_collision"};
+constexpr Keys kKindKeys[] = {kLatticeKeys,       kRandomKeys,      kListKeys,         kFluidBlockKeys, kPlummerKeys,
+                              kUniformSphereKeys, kUniformCubeKeys, kColdCollapseKeys, kCollisionKeys};
+constexpr std::size_t kFirstStellarKind = 4;
 constexpr std::string_view kPrecisions[] = {"float", "double"};       // the order of Precision
 constexpr std::string_view kFormats[] = {"vtp", "csv"};               // the order of OutputFormat
 
@@ -207,6 +223,7 @@ class Table {
   [[noreturn]] void fail(std::string_view k, std::string_view reason) const { r_.fail(key(k), reason); }
 
   const toml::node* find(std::string_view k) const { return table_ ? table_->get(k) : nullptr; }
+  bool reader_has_table() const { return table_ != nullptr; }
   const toml::node& need(std::string_view k, std::string_view hint = "") const {
     if (const auto* node = find(k)) return *node;
     fail(k, fmt::format("missing required key{}", hint));
@@ -290,7 +307,8 @@ class Table {
 
 void read_simulation(const Table& t, Scene& s) {
   t.only(kSimulationKeys);
-  s.precision = static_cast<Precision>(t.choice("precision", kPrecisions, 0, "precision"));
+  s.precision = static_cast<Precision>(
+      t.choice("precision", kPrecisions, static_cast<std::size_t>(s.precision), "precision"));
   s.dt = t.number("dt", {}, kPositive);
   const bool has_end_time = t.find("end_time") != nullptr;
   const bool has_steps = t.find("steps") != nullptr;
@@ -343,7 +361,7 @@ std::uint64_t read_seed(const Table& t) { return static_cast<std::uint64_t>(t.in
 // A lattice; a fluid block (fluid = true) takes its mass from [sph].
 LatticeSource read_lattice(const Table& t, const Scene& s, bool fluid) {
   LatticeSource src;
-  src.region = t.box(&s.box);
+  src.region = t.box(s.walls ? &s.box : nullptr);
   src.spacing = t.number("spacing", {}, kPositive);
   src.jitter = t.number("jitter", 0.0, kJitter);
   src.seed = read_seed(t);
@@ -367,7 +385,7 @@ LatticeSource read_lattice(const Table& t, const Scene& s, bool fluid) {
 
 RandomSource read_random(const Table& t, const Scene& s) {
   RandomSource src;
-  src.region = t.box(&s.box);
+  src.region = t.box(s.walls ? &s.box : nullptr);
   src.count = static_cast<std::size_t>(t.integer("count", {}, 1, static_cast<std::int64_t>(detail::kMaxParticles)));
   src.seed = read_seed(t);
   src.mass = t.number("mass", {}, kPositive);
@@ -384,7 +402,7 @@ ListSource read_list(const Table& t, const Scene& s) {
   for (std::size_t i = 0; i < positions.size(); ++i) {
     const std::string item = fmt::format("{}[{}]", where, i);
     src.positions.push_back(r.vec3(positions[i], item));
-    r.inside(s.box, src.positions.back(), item);
+    if (s.walls) r.inside(s.box, src.positions.back(), item);
   }
   // Per-particle arrays must match positions one to one.
   auto per_particle = [&](std::string_view k, std::string_view expected) -> const toml::array& {
@@ -414,6 +432,42 @@ ListSource read_list(const Table& t, const Scene& s) {
   return src;
 }
 
+// The self-gravitating models (kinds from kFirstStellarKind on).
+StellarSource read_stellar(const Table& t, const Scene& s, std::size_t kind) {
+  using Model = StellarSource::Model;
+  if (s.walls) t.fail("kind", fmt::format("'{}' is a self-gravitating model: it needs open space (no [box])", kKinds[kind]));
+  StellarSource src;
+  src.model = static_cast<Model>(kind - kFirstStellarKind);
+  src.count = static_cast<std::size_t>(t.integer("count", {}, 1, static_cast<std::int64_t>(detail::kMaxParticles)));
+  src.seed = read_seed(t);
+  src.offset = t.vec3("offset", Vec3d{});
+  src.velocity = t.vec3("velocity", Vec3d{});
+  const Range cut{0, 1, true, false};
+  switch (src.model) {
+    case Model::Plummer: src.plummer.mass_cut = t.number("mass_cut", 0.999, cut); break;
+    case Model::UniformSphere:
+      src.size = t.number("radius", 1.0, kPositive);
+      src.mass = t.number("mass", 1.0, kPositive);
+      break;
+    case Model::UniformCube:
+      src.size = t.number("side", 1.0, kPositive);
+      src.mass = t.number("mass", 1.0, kPositive);
+      break;
+    case Model::ColdCollapse: break;
+    case Model::PlummerCollision: {
+      auto& c = src.collision;
+      if (src.count < 2) t.fail("count", "a collision needs at least 2 particles");
+      c.mass_fraction = t.number("mass_fraction", 0.5, Range{0, 1, true, true});
+      c.separation = t.number("separation", 10.0, kPositive);
+      c.impact_parameter = t.number("impact_parameter", 2.0, Range{0, c.separation, false, true});
+      if (t.find("relative_velocity")) c.relative_velocity = t.number("relative_velocity", {}, kNonNegative);
+      c.mass_cut = t.number("mass_cut", 0.999, cut);
+      break;
+    }
+  }
+  return src;
+}
+
 void read_particles(const Table& top, Scene& s) {
   const Reader& r = top.reader();
   if (s.random_box) return;  // its one source was made by read_random_box()
@@ -430,7 +484,8 @@ void read_particles(const Table& top, Scene& s) {
     t.only(kKindKeys[kind], fmt::format("unknown key for kind '{}'", kKinds[kind]));
     if (kind == 0 || kind == 3) s.sources.emplace_back(read_lattice(t, s, kind == 3));
     else if (kind == 1) s.sources.emplace_back(read_random(t, s));
-    else s.sources.emplace_back(read_list(t, s));
+    else if (kind == 2) s.sources.emplace_back(read_list(t, s));
+    else s.sources.emplace_back(read_stellar(t, s, kind));
     const std::uint64_t n = detail::source_count(s.sources.back());
     if (n > detail::kMaxParticles)
       r.fail(where, fmt::format("makes {} particles, more than the limit of {} (2^31); is the spacing too small?",
@@ -483,6 +538,20 @@ void read_sph(const Table& top, Scene& s) {
   s.sph = p;
 }
 
+// [nbody]: self-gravity.
+void read_nbody(const Table& t, Scene& s) {
+  if (!t.reader_has_table()) return;
+  t.only(kNbodyKeys);
+  gravity::GravitySettings g;
+  g.method = static_cast<gravity::Method>(t.choice("method", kMethods, 1, "method"));
+  g.scheme = static_cast<gravity::Scheme>(t.choice("scheme", kSchemes, 2, "scheme"));
+  g.opening = t.number("opening", 0.5, kUnit);
+  g.softening = t.number("softening", 0.01, kNonNegative);
+  g.subdomain_size = static_cast<std::size_t>(t.integer("subdomain_size", 208, 1));
+  g.subtree_nodes = static_cast<std::size_t>(t.integer("subtree_nodes", 370, 1));
+  s.nbody = g;
+}
+
 // [random_box] with the root key `particles` = N: the thesis's section 5 set-up.
 void read_random_box(const Table& top, Scene& s) {
   if (!top.find("random_box")) return;
@@ -515,9 +584,14 @@ Scene read_scene(const toml::table& root, std::string_view file) {
   top.only(kSections, "unknown section");
   Scene s;
   s.file = std::string(file);
+  // Self-gravity defaults to double precision, fluids to float.
+  s.precision = top.find("nbody") ? Precision::Double : Precision::Float;
   read_simulation(top.table("simulation"), s);
   read_sph(top, s);
-  if (top.find("random_box")) {
+  read_nbody(top.table("nbody"), s);
+  if (!top.find("box") && !top.find("random_box")) {
+    s.walls = false;  // open space
+  } else if (top.find("random_box")) {
     const Table box = top.table("box");
     box.only(kBoxKeys);
     s.restitution = box.number("restitution", 0.5, kUnit);
@@ -527,7 +601,8 @@ Scene read_scene(const toml::table& root, std::string_view file) {
   }
   const Table forces = top.table("forces");
   forces.only(kForcesKeys);
-  s.gravity = forces.vec3("gravity", s.gravity);
+  // A self-gravitating system floats in open space unless told otherwise.
+  s.gravity = forces.vec3("gravity", s.nbody ? Vec3d{} : s.gravity);
   read_output(top.table("output"), s);
   read_particles(top, s);
   return s;
@@ -628,7 +703,7 @@ std::string canonical_text(const Scene& s) {
   if (s.end_time) put("end_time = {:.17g}\n", *s.end_time);
   if (s.steps) put("steps = {}\n", *s.steps);
   put("block_size = {}\n", s.block_size);
-  put("[box]\nmin = {}\nmax = {}\nrestitution = {:.17g}\n", vec(s.box.lo), vec(s.box.hi), s.restitution);
+  if (s.walls) put("[box]\nmin = {}\nmax = {}\nrestitution = {:.17g}\n", vec(s.box.lo), vec(s.box.hi), s.restitution);
   put("[forces]\ngravity = {}\n", vec(s.gravity));
   put("[output]\ninterval = {:.17g}\nformat = [", s.output_interval);
   for (std::size_t i = 0; i < s.formats.size(); ++i)
@@ -642,6 +717,11 @@ std::string canonical_text(const Scene& s) {
         kNegativePressures[static_cast<std::size_t>(s.sph->negative_pressure)], s.sph->buckets,
         s.sph->duplicate_check);
   }
+  if (s.nbody)
+    put("[nbody]\nmethod = \"{}\"\nscheme = \"{}\"\nopening = {:.17g}\nsoftening = {:.17g}\nsubdomain_size = {}\n"
+        "subtree_nodes = {}\n",
+        kMethods[static_cast<std::size_t>(s.nbody->method)], kSchemes[static_cast<std::size_t>(s.nbody->scheme)],
+        s.nbody->opening, s.nbody->softening, s.nbody->subdomain_size, s.nbody->subtree_nodes);
   if (s.random_box)
     put("[random_box]\nparticles = {}\nneighbours = {:.17g}\nseed = {}\n", s.random_box->particles,
         s.random_box->neighbors, s.random_box->seed);
@@ -654,6 +734,13 @@ std::string canonical_text(const Scene& s) {
       put("[[particles]]\nkind = \"random\"\nmin = {}\nmax = {}\ncount = {}\nseed = {}\n", vec(q->region.lo),
           vec(q->region.hi), q->count, q->seed);
       put("mass = {:.17g}\nvelocity = {}\n", q->mass, vec(q->velocity));
+    } else if (const auto* m = std::get_if<StellarSource>(&source)) {
+      put("[[particles]]\nkind = \"{}\"\ncount = {}\nseed = {}\nsize = {:.17g}\nmass = {:.17g}\noffset = {}\n",
+          kKinds[kFirstStellarKind + static_cast<std::size_t>(m->model)], m->count, m->seed, m->size, m->mass,
+          vec(m->offset));
+      put("velocity = {}\nmass_cut = {:.17g}\ncollision = [{:.17g}, {:.17g}, {:.17g}, {:.17g}, {:.17g}]\n",
+          vec(m->velocity), m->plummer.mass_cut, m->collision.mass_fraction, m->collision.separation,
+          m->collision.impact_parameter, m->collision.relative_velocity.value_or(-1.0), m->collision.mass_cut);
     } else {
       const auto& list = std::get<ListSource>(source);
       put("[[particles]]\nkind = \"list\"\npositions = [");

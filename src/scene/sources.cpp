@@ -37,6 +37,7 @@ std::uint64_t source_count(const ParticleSource& source) {
     }
     std::uint64_t operator()(const RandomSource& s) const { return s.count; }
     std::uint64_t operator()(const ListSource& s) const { return s.positions.size(); }
+    std::uint64_t operator()(const StellarSource& s) const { return s.count; }
   } count;
   return std::visit(count, source);
 }
@@ -104,6 +105,21 @@ class Filler {
   void operator()(const ListSource& s) {
     for (std::size_t n = 0; n < s.positions.size(); ++n)
       put(s.positions[n], s.velocities.empty() ? Vec3d{} : s.velocities[n], s.masses[n]);
+  }
+
+  void operator()(const StellarSource& s) {
+    using Model = StellarSource::Model;
+    ParticleSet<Real> model;
+    switch (s.model) {
+      case Model::Plummer: model = gravity::plummer<Real>(s.count, s.seed, s.plummer); break;
+      case Model::UniformSphere: model = gravity::uniform_sphere<Real>(s.count, s.seed, s.size, s.mass); break;
+      case Model::UniformCube: model = gravity::uniform_cube<Real>(s.count, s.seed, s.size, s.mass); break;
+      case Model::ColdCollapse: model = gravity::cold_collapse<Real>(s.count, s.seed); break;
+      case Model::PlummerCollision: model = gravity::plummer_collision<Real>(s.count, s.seed, s.collision); break;
+    }
+    for (std::size_t n = 0; n < model.size(); ++n)
+      put(model.position.get(n).template cast<double>() + s.offset,
+          model.velocity.get(n).template cast<double>() + s.velocity, double(model.mass[n]));
   }
 
  private:

@@ -12,6 +12,7 @@
 #include "swirl/io/vtp.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sim/build.hpp"
+#include "swirl/gravity/diagnostics.hpp"
 #include "swirl/sph/diagnostics.hpp"
 
 namespace swirl::sim {
@@ -80,13 +81,20 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   auto built = build_simulation<Real>(scene);
   Simulation<Real>& sim = built.sim;
   const sph::SphFluid<Real>* fluid = built.fluid;
+  const gravity::GravityForce<Real>* self_gravity = built.self_gravity;
   std::optional<CsvLog> diagnostics;
   if (fluid)
     diagnostics.emplace(options.out_dir / "diagnostics.csv",
                         "time,kinetic_energy,potential_energy,momentum_x,momentum_y,momentum_z,"
                         "mean_density_error,max_density_error,mean_neighbours");
+  else if (self_gravity)
+    diagnostics.emplace(options.out_dir / "diagnostics.csv",
+                        "time,kinetic_energy,potential_energy,total_energy,relative_energy_error,momentum_x,"
+                        "momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z,virial_ratio,"
+                        "mean_nodes_visited");
+  std::optional<double> initial_energy;  // gravity runs: E at t = 0
+  double energy_error = 0;
   summary.particles = sim.particles().size();
-  summary.bytes_per_particle = bytes_per_particle(sim.particles());
 
   const std::uint64_t total = options.steps.value_or(scene.total_steps());
   FrameWriter<Real> writer(scene, options.out_dir);
@@ -95,20 +103,28 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   auto write_frame = [&] {
     ScopedPhase phase(sim.timers(), "output");
     writer.write(sim.particles(), sim.time());
-    if (diagnostics) {
+    if (fluid) {
       const auto d = sph::fluid_diagnostics(sim.particles(), scene.gravity, scene.sph->rest_density, scene.block_size);
       diagnostics->add({sim.time(), d.kinetic_energy, d.potential_energy, d.momentum.x, d.momentum.y, d.momentum.z,
                         d.mean_density_error, d.max_density_error, fluid->mean_neighbors()});
+    } else if (self_gravity) {
+      const auto d = gravity::diagnose(sim.particles(), scene.block_size);
+      if (!initial_energy) initial_energy = d.total;
+      energy_error = *initial_energy != 0 ? (d.total - *initial_energy) / std::abs(*initial_energy) : 0.0;
+      diagnostics->add({sim.time(), d.kinetic, d.potential, d.total, energy_error, d.momentum.x, d.momentum.y,
+                        d.momentum.z, d.angular_momentum.x, d.angular_momentum.y, d.angular_momentum.z, d.virial_ratio,
+                        self_gravity->stats().mean_nodes_visited});
     }
   };
-  double neighbor_sum = 0;  // of the per-evaluation means, for the summary
+  double neighbor_sum = 0, nodes_sum = 0;  // per-evaluation means, summed for the summary
 
   // Frame k is due at the first step with time ≥ k·interval; the slack keeps
   // k·interval that lands on a step (up to rounding) on that step.
   const double interval = scene.output_interval;
   const double slack = 1e-9 * scene.dt;
   std::uint64_t next_frame = 1;
-  sim.start();
+  sim.start();  // force models add their fields (density, potential) here
+  summary.bytes_per_particle = bytes_per_particle(sim.particles());
   write_frame();
   bool last_written = true;
   if (on_progress) on_progress({0, total, 0.0, wall()});
@@ -116,6 +132,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
     for (std::uint64_t s = 0; s < total; ++s) {
       sim.step();
       if (fluid) neighbor_sum += fluid->mean_neighbors();
+      if (self_gravity) nodes_sum += self_gravity->stats().mean_nodes_visited;
       last_written = false;
       if (interval > 0 && sim.time() + slack >= static_cast<double>(next_frame) * interval) {
         write_frame();
@@ -137,9 +154,13 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   summary.steps_per_second = summary.wall_seconds > 0 ? static_cast<double>(summary.steps) / summary.wall_seconds : 0;
   summary.phases = sim.timers().phases();
   summary.frames = writer.frames();
-  if (fluid) {
-    const double evaluations = static_cast<double>(summary.steps);
+  const double evaluations = static_cast<double>(summary.steps);
+  if (fluid)
     summary.metrics.emplace_back("mean_neighbours", evaluations > 0 ? neighbor_sum / evaluations : fluid->mean_neighbors());
+  if (self_gravity) {
+    summary.metrics.emplace_back("relative_energy_error", energy_error);  // at the last frame
+    summary.metrics.emplace_back("mean_nodes_visited",
+                                 evaluations > 0 ? nodes_sum / evaluations : self_gravity->stats().mean_nodes_visited);
   }
   return summary;
 }

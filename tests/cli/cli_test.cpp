@@ -188,6 +188,25 @@ TEST_F(Cli, HashStatsPrintsTable52) {
   EXPECT_NE(r.err.find("[sph]"), std::string::npos) << r.err;
 }
 
+TEST_F(Cli, PlummerRunsWithEveryScheme) {
+  const std::string scene = std::string(SWIRL_SOURCE_DIR) + "/examples/plummer.toml";
+  for (const char* scheme : {"subdomain", "subtree", "global"}) {
+    const auto out = dir_ / scheme;
+    const auto r = swirl("run " + scene + " --set particles.0.count=600 --steps 3 --out " + out.string() +
+                         " --set 'nbody.scheme=\"" + scheme + "\"'");
+    ASSERT_EQ(r.status, 0) << scheme << ": " << r.err;
+    EXPECT_NE(r.out.find("relative_energy_error"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("forces.tree_build"), std::string::npos) << r.out;
+    const auto frames = swirl::io::read_pvd(out / "particles.pvd");
+    ASSERT_EQ(frames.size(), 2u);
+    const auto last = swirl::io::read_vtp(out / frames.back().file);
+    ASSERT_TRUE(last.point_data.count("potential")) << scheme;
+    for (double phi : last.point_data.at("potential").values<double>()) EXPECT_LT(phi, 0.0);
+    const std::string csv = slurp(out / "diagnostics.csv");
+    EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 3) << csv;  // header and two frames
+  }
+}
+
 TEST_F(Cli, InfoNamesTheBuild) {
   const auto r = swirl("info");
   ASSERT_EQ(r.status, 0);

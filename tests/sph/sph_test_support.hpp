@@ -40,4 +40,36 @@ ParticleSet<Real> lattice_fluid(Vec3d lo, Vec3d hi, double s, double h, double r
   return lattice_fluid<Real>(lo, hi, s, h, rho0, [](const Vec3d&) { return true; });
 }
 
+// A lattice stretched along z so that its density falls linearly with height
+// (ρ ≈ ρ0·(1 − δ·z)), frozen: the SPH pressure force of interior particles
+// against the analytic −(1/ρ)·dp/dz = c²·δ. Eq. 2.8 gives half of it (see
+// sph_fluid.hpp), the consistent form all of it.
+template <class Real>
+inline double pressure_acceleration_ratio(sph::PressureForm form) {
+  const double s = 0.01, h = 2.1 * s, rho0 = 1000, c = 20, side = 0.2, delta = 9.81 / (c * c);
+  auto p = swirl::testing::lattice_fluid<Real>({0, 0, 0}, {side, side, side}, s, h, rho0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double z = p.position.z[i];
+    p.position.z[i] = Real(z + delta * z * z / 2);  // local stretch 1 + δ·z
+  }
+  sph::SphParameters params;
+  params.smoothing_length = h;
+  params.rest_density = rho0;
+  params.sound_speed = c;
+  params.viscosity = 0;
+  params.pressure_form = form;
+  sph::SphFluid<Real> fluid(params);
+  fluid.add_acceleration(p, ForceContext{0, 128, nullptr});
+  double sum = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    bool deep = true;
+    for (int a = 0; a < 3; ++a) deep = deep && p.position[a][i] > 2.5 * h && p.position[a][i] < side - 2.5 * h;
+    if (!deep) continue;
+    sum += p.acceleration.z[i] / (c * c * delta * rho0 / p.density[i]);
+    ++n;
+  }
+  return sum / n;
+}
+
 }  // namespace swirl::testing

@@ -3,7 +3,8 @@
 //
 // Units are SI for SPH scenes (m, s, kg) and G = 1 N-body units for gravity
 // scenes. Every value here has passed validation: dt > 0, a valid box,
-// restitution in [0, 1], at least one particle, all particles inside the box.
+// restitution in [0, 1], at least one particle, all particles inside the box
+// (when the scene has walls).
 #pragma once
 
 #include <cstddef>
@@ -16,6 +17,8 @@
 
 #include "swirl/core/box.hpp"
 #include "swirl/core/vec3.hpp"
+#include "swirl/gravity/initial_conditions.hpp"
+#include "swirl/gravity/settings.hpp"
 #include "swirl/sph/parameters.hpp"
 
 namespace swirl::scene {
@@ -53,7 +56,22 @@ struct ListSource {
   std::vector<double> masses;     // one per position
 };
 
-using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource>;
+// A self-gravitating model from gravity/initial_conditions.hpp (G = 1 units),
+// moved by `offset` and given the extra bulk `velocity`.
+struct StellarSource {
+  enum class Model { Plummer, UniformSphere, UniformCube, ColdCollapse, PlummerCollision };
+  Model model = Model::Plummer;
+  std::size_t count = 0;
+  std::uint64_t seed = 1;
+  double size = 1;   // uniform_sphere: radius; uniform_cube: side
+  double mass = 1;   // uniform_sphere, uniform_cube: total mass
+  gravity::PlummerOptions plummer;      // plummer
+  gravity::CollisionOptions collision;  // plummer_collision
+  Vec3d offset{};
+  Vec3d velocity{};
+};
+
+using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource>;
 
 struct Scene {
   std::string file;                        // where it came from, for messages
@@ -63,7 +81,8 @@ struct Scene {
   std::optional<std::uint64_t> steps;      // simulation.steps
   std::size_t block_size = 1024;           // simulation.block_size: particles per work block, ≥ 1
 
-  Box<double> box;                         // box.min, box.max, m
+  bool walls = true;                       // a [box] section: walls; without one, open space
+  Box<double> box;                         // box.min, box.max, m (used only with walls)
   double restitution = 0.5;                // box.restitution, e in [0, 1]
 
   Vec3d gravity{0, 0, -9.81};              // forces.gravity, m/s², uniform
@@ -87,6 +106,9 @@ struct Scene {
     std::uint64_t seed = 1;        // random_box.seed
   };
   std::optional<RandomBox> random_box;
+
+  // [nbody]: self-gravity (Barnes–Hut or direct sum), G = 1 units.
+  std::optional<gravity::GravitySettings> nbody;
 
   // Number of steps the scene asks for: `steps`, or ceil(end_time / dt) (a step
   // that would overshoot end_time by less than 1e-9·dt is not added).

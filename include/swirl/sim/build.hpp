@@ -1,11 +1,13 @@
 // Building the Simulation a scene describes: its particles, its box and its
-// force models (SPH when the scene has [sph], uniform gravity when non-zero).
+// force models (SPH when the scene has [sph], self-gravity with [nbody],
+// uniform gravity when non-zero). Without walls the space is open.
 // Shared by run_scene() and the tools that inspect a scene (hash-stats).
 #pragma once
 
 #include <memory>
 
 #include "swirl/force/uniform_gravity.hpp"
+#include "swirl/gravity/gravity_force.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/scene.hpp"
 #include "swirl/sim/simulation.hpp"
@@ -16,7 +18,8 @@ namespace swirl::sim {
 template <class Real>
 struct SceneSimulation {
   Simulation<Real> sim;
-  sph::SphFluid<Real>* fluid = nullptr;  // owned by sim; null without [sph]
+  sph::SphFluid<Real>* fluid = nullptr;             // owned by sim; null without [sph]
+  gravity::GravityForce<Real>* self_gravity = nullptr;  // owned by sim; null without [nbody]
 };
 
 template <class Real>
@@ -24,11 +27,16 @@ SceneSimulation<Real> build_simulation(const scene::Scene& scene) {
   SimulationSettings settings;
   settings.dt = scene.dt;
   settings.block_size = scene.block_size;
-  settings.box = boundary::BoxCollision<double>{scene.box, scene.restitution};
-  SceneSimulation<Real> out{Simulation<Real>(scene::make_particles<Real>(scene), settings), nullptr};
+  if (scene.walls) settings.box = boundary::BoxCollision<double>{scene.box, scene.restitution};
+  SceneSimulation<Real> out{Simulation<Real>(scene::make_particles<Real>(scene), settings)};
   if (scene.sph) {
     auto model = std::make_unique<sph::SphFluid<Real>>(*scene.sph);
     out.fluid = model.get();
+    out.sim.add_force(std::move(model));
+  }
+  if (scene.nbody) {
+    auto model = std::make_unique<gravity::GravityForce<Real>>(*scene.nbody);
+    out.self_gravity = model.get();
     out.sim.add_force(std::move(model));
   }
   if (!(scene.gravity == Vec3d{}))

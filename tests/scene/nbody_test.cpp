@@ -1,0 +1,102 @@
+// Gravity scenes: [nbody] and the self-gravitating particle models.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "swirl/scene/initial_conditions.hpp"
+#include "swirl/scene/load.hpp"
+
+namespace {
+
+using namespace swirl::scene;
+
+const std::string kPlummer = R"(
+[simulation]
+dt = 0.01
+steps = 10
+
+[nbody]
+scheme = "subtree"
+opening = 0.7
+softening = 0.02
+
+[[particles]]
+kind = "plummer"
+count = 1000
+seed = 3
+)";
+
+std::string error_of(const std::string& text, std::vector<std::string> overrides = {}) {
+  try {
+    parse_scene(text, "g.toml", overrides);
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "<no error>";
+}
+
+TEST(NbodyScene, PlummerSceneParsesIntoOpenSpaceInDouble) {
+  const Scene s = parse_scene(kPlummer, "g.toml");
+  ASSERT_TRUE(s.nbody);
+  EXPECT_EQ(s.nbody->scheme, swirl::gravity::Scheme::subtree);
+  EXPECT_EQ(s.nbody->method, swirl::gravity::Method::barnes_hut);
+  EXPECT_EQ(s.nbody->opening, 0.7);
+  EXPECT_EQ(s.nbody->softening, 0.02);
+  EXPECT_EQ(s.nbody->subdomain_size, 208u);
+  EXPECT_EQ(s.nbody->subtree_nodes, 370u);
+  EXPECT_FALSE(s.walls);
+  EXPECT_EQ(s.precision, Precision::Double);
+  EXPECT_EQ(s.gravity, swirl::Vec3d{});
+  const auto p = make_particles<double>(s);
+  ASSERT_EQ(p.size(), 1000u);
+  double mass = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) mass += p.mass[i];
+  EXPECT_NEAR(mass, 1.0, 1e-12);
+  // The same seed gives the same particles; precision can be chosen.
+  EXPECT_EQ(make_particles<double>(s).position.x, p.position.x);
+  const auto f = make_particles<float>(parse_scene(kPlummer, "g.toml", std::vector<std::string>{"simulation.precision=\"float\""}));
+  EXPECT_EQ(f.size(), 1000u);
+}
+
+TEST(NbodyScene, ModelsAreMovedByOffsetAndVelocity) {
+  const Scene s = parse_scene(kPlummer + R"(
+[[particles]]
+kind = "uniform_sphere"
+count = 500
+radius = 2.0
+mass = 3.0
+offset = [10.0, 0.0, 0.0]
+velocity = [0.0, 1.0, 0.0]
+)", "g.toml");
+  const auto p = make_particles<double>(s);
+  ASSERT_EQ(p.size(), 1500u);
+  double mass = 0, x = 0, vy = 0;
+  for (std::size_t i = 1000; i < 1500; ++i) {
+    mass += p.mass[i];
+    x += p.mass[i] * p.position.x[i];
+    vy += p.mass[i] * p.velocity.y[i];
+    EXPECT_LE(std::hypot(p.position.x[i] - 10.0, p.position.y[i], p.position.z[i]), 2.0 + 1e-12);
+    EXPECT_EQ(p.id[i], i);
+  }
+  EXPECT_NEAR(mass, 3.0, 1e-12);
+  EXPECT_NEAR(x / mass, 10.0, 0.2);
+  EXPECT_NEAR(vy / mass, 1.0, 1e-12);
+}
+
+TEST(NbodyScene, BadGravityInputIsRefusedClearly) {
+  EXPECT_EQ(error_of(kPlummer, {"nbody.opening=1.5"}), "g.toml: nbody.opening: must be in [0, 1], got 1.5");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.opening=-0.1"}), "g.toml: nbody.opening: must be in [0, 1], got -0.1");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.softening=-0.01"}), "g.toml: nbody.softening: must be >= 0, got -0.01");
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.count=0"}), "g.toml: particles[0].count: must be in [1, 2147483648], got 0");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.scheme=\"octree\""}),
+            "g.toml: nbody.scheme: unknown scheme 'octree' (allowed: 'subdomain', 'subtree', 'global')");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.method=\"fmm\""}),
+            "g.toml: nbody.method: unknown method 'fmm' (allowed: 'direct', 'barnes_hut')");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.theta=0.5"}), "g.toml: nbody.theta: unknown key");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.opneing=0.5"}), "g.toml: nbody.opneing: unknown key (did you mean 'opening'?)");
+  EXPECT_NE(error_of(kPlummer + "[box]\nmin = [-5, -5, -5]\nmax = [5, 5, 5]\n").find("needs open space"), std::string::npos);
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"plummer_collision\"", "particles.0.impact_parameter=20"}),
+            "g.toml: particles[0].impact_parameter: must be in [0, 10), got 20");
+}
+
+}  // namespace
