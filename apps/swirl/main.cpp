@@ -2,6 +2,7 @@
 //
 //   swirl run SCENE [--threads N] [--out DIR] [--steps N] [--set key=value]... [--summary-json FILE]
 //   swirl hash-stats SCENE [--set key=value]... [--steps N] [--threads N]
+//   swirl bench sph|gravity [options]
 //   swirl info
 //
 // Exit status: 0 done, 1 the run failed (blow-up, write error), 2 bad input.
@@ -15,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "bench.hpp"
 #include "cli.hpp"
 #include "swirl/config.hpp"
 #include "swirl/io/atomic_file.hpp"
@@ -137,6 +139,22 @@ int main(int argc, char** argv) {
   hash_cmd->add_option("--steps", hs.steps, "Run N steps before measuring (default: the initial positions)");
   hash_cmd->add_option("--threads,-t", hs.threads, "Threads")->check(CLI::PositiveNumber);
 
+  swirl::cli::BenchArgs bench;
+  auto* bench_cmd = app.add_subcommand("bench", "Measure the seeds' performance tables on this machine");
+  bench_cmd->require_subcommand(1);
+  auto* bench_sph = bench_cmd->add_subcommand("sph", "Steps per second of the thesis's random box (Tables 5.1, 5.3)");
+  bench_sph->add_option("--particles", bench.particles, "Particle counts")->delimiter(',');
+  bench_sph->add_option("--neighbours", bench.neighbours, "Target neighbour counts")->delimiter(',');
+  bench_sph->add_option("--threads", bench.threads, "Thread counts")->delimiter(',');
+  bench_sph->add_option("--steps", bench.steps, "Timed steps")->check(CLI::PositiveNumber);
+  bench_sph->add_option("--warmup", bench.warmup, "Steps before timing")->check(CLI::NonNegativeNumber);
+  auto* bench_grav = bench_cmd->add_subcommand("gravity", "Seconds for Barnes-Hut iterations (the paper's Table 2)");
+  bench_grav->add_option("--particles", bench.gravity_particles, "Particle counts")->delimiter(',');
+  bench_grav->add_option("--threads", bench.threads, "Thread counts")->delimiter(',');
+  bench_grav->add_option("--schemes", bench.schemes, "subdomain,subtree,global")->delimiter(',');
+  bench_grav->add_option("--iterations", bench.iterations, "Iterations")->check(CLI::PositiveNumber);
+  bench_grav->add_option("--opening", bench.opening, "Opening criterion lambda")->check(CLI::Range(0.0, 1.0));
+
   app.add_subcommand("info", "Print version, build and machine facts");
 
   try {
@@ -148,6 +166,8 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("info")) return print_info();
     if (app.got_subcommand("hash-stats")) return hash_stats(hs);
+    if (bench_sph->parsed()) return swirl::cli::bench_sph(bench);
+    if (bench_grav->parsed()) return swirl::cli::bench_gravity(bench);
     return run(args);
   } catch (const swirl::scene::SceneError& e) {
     fmt::print(stderr, "swirl: error: {}\n", e.what());
