@@ -1,5 +1,7 @@
 #include "swirl/io/atomic_file.hpp"
 
+#include "detail.hpp"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -110,5 +112,7 @@ void ensure_writable_directory(const fs::path& dir) {
   if (probe.open() < 0) fail(dir, "directory is not writable", errno);
   if (probe.close() != 0) fail(dir, "directory is not writable (close failed)", errno);
 }
+
+std::string read_text_file(const std::filesystem::path& path) { return detail::read_file(path); }
 
 }  // namespace swirl::io

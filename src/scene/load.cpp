@@ -11,6 +11,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -766,7 +767,11 @@ Scene parse_scene(std::string_view text, std::string_view file, std::span<const 
   }
   const Reader r(file);
   for (const auto& o : overrides) apply_override(root, o, r);
-  return read_scene(root, file);
+  Scene scene = read_scene(root, file);
+  std::ostringstream effective;
+  effective << root;
+  scene.toml = effective.str();
+  return scene;
 }
 
 Scene load_scene(const std::filesystem::path& file, std::span<const std::string> overrides) {

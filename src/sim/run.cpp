@@ -1,16 +1,21 @@
 #include "swirl/sim/run.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
+#include <sstream>
 
 #include <fmt/format.h>
 
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/checkpoint.hpp"
 #include "swirl/io/csv.hpp"
 #include "swirl/io/pvd.hpp"
 #include "swirl/io/vtp.hpp"
 #include "swirl/parallel/for_blocks.hpp"
+#include "swirl/scene/load.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/gravity/diagnostics.hpp"
 #include "swirl/sph/diagnostics.hpp"
@@ -24,6 +29,18 @@ class FrameWriter {
  public:
   FrameWriter(const scene::Scene& scene, const std::filesystem::path& dir)
       : scene_(scene), dir_(dir), series_(dir / "particles.pvd") {}
+
+  // Continues after the first `frames` frames (those written before the
+  // checkpoint; later ones, such as the final frame of a run that went on
+  // past it, are replaced).
+  void resume(std::size_t frames) {
+    frames_ = frames;
+    const auto pvd = dir_ / "particles.pvd";
+    if (!std::filesystem::exists(pvd)) return;
+    auto entries = io::read_pvd(pvd);
+    if (entries.size() > frames) entries.resize(frames);
+    series_.set_entries(std::move(entries));
+  }
 
   void write(const ParticleSet<Real>& p, double time) {
     for (auto format : scene_.formats) {
@@ -51,6 +68,15 @@ class FrameWriter {
 class CsvLog {
  public:
   CsvLog(std::filesystem::path path, std::string header) : path_(std::move(path)), text_(std::move(header) + "\n") {}
+
+  // Continues an existing log, keeping its first `rows` rows.
+  void resume(std::size_t rows) {
+    if (!std::filesystem::exists(path_)) return;
+    std::istringstream in(io::read_text_file(path_));
+    std::string line;
+    std::getline(in, line);  // the header, as this version writes it
+    for (std::size_t k = 0; k < rows && std::getline(in, line); ++k) text_ += line + "\n";
+  }
   void add(const std::vector<double>& row) {
     for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
     text_ += "\n";
@@ -69,6 +95,30 @@ std::size_t bytes_per_particle(const ParticleSet<Real>& p) {
   return bytes;
 }
 
+// Named values of the run kept in checkpoints (io::CheckpointValues).
+double value_of(const io::CheckpointValues& values, std::string_view name, double fallback) {
+  for (const auto& [n, v] : values)
+    if (n == name) return v;
+  return fallback;
+}
+
+// Steps from t = 0 to time t (the same rounding as Scene::total_steps).
+std::uint64_t steps_until(double t, double dt) {
+  return static_cast<std::uint64_t>(std::max(0.0, std::ceil(t / dt - 1e-9)));
+}
+
+std::filesystem::path checkpoint_dir(const std::filesystem::path& out) { return out / "checkpoints"; }
+
+// Checkpoint files, newest (highest step) first.
+std::vector<std::filesystem::path> checkpoints_in(const std::filesystem::path& out) {
+  std::vector<std::filesystem::path> files;
+  if (!std::filesystem::is_directory(checkpoint_dir(out))) return files;
+  for (const auto& e : std::filesystem::directory_iterator(checkpoint_dir(out)))
+    if (e.path().extension() == ".swc") files.push_back(e.path());
+  std::sort(files.rbegin(), files.rend());
+  return files;
+}
+
 template <class Real>
 RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
                      const std::function<void(const RunProgress&)>& on_progress) {
@@ -77,6 +127,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   summary.precision = std::is_same_v<Real, float> ? "float" : "double";
   summary.out_dir = options.out_dir;
   summary.threads = parallel::thread_count();
+  const std::uint64_t hash = scene::scene_hash(scene);
 
   auto built = build_simulation<Real>(scene);
   Simulation<Real>& sim = built.sim;
@@ -92,69 +143,142 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
                         "time,kinetic_energy,potential_energy,total_energy,relative_energy_error,momentum_x,"
                         "momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z,virial_ratio,"
                         "mean_nodes_visited");
-  std::optional<double> initial_energy;  // gravity runs: E at t = 0
-  double energy_error = 0;
   summary.particles = sim.particles().size();
 
-  const std::uint64_t total = options.steps.value_or(scene.total_steps());
+  // Run state that must survive a restart, saved in every checkpoint.
   FrameWriter<Real> writer(scene, options.out_dir);
+  double initial_energy = std::numeric_limits<double>::quiet_NaN();  // gravity runs: E at t = 0
+  double energy_error = 0;
+  double neighbor_sum = 0, nodes_sum = 0;  // per-evaluation means, summed for the summary
+  std::uint64_t next_frame = 1, last_frame_step = 0, next_checkpoint = 1;
+
+  if (options.resume) {
+    io::CheckpointValues values;
+    std::optional<io::CheckpointHeader> header;
+    for (const auto& file : checkpoints_in(options.out_dir)) {
+      try {
+        const auto h = io::read_checkpoint(file, sim.particles(), values);
+        if (h.scene_hash != hash)
+          throw io::IoError(fmt::format("{}: belongs to another scene (hash {:016x}, the scene's is {:016x})",
+                                        file.string(), h.scene_hash, hash));
+        header = h;
+        summary.last_checkpoint = file;
+        break;
+      } catch (const io::IoError& e) {
+        summary.warnings.push_back(fmt::format("skipping checkpoint: {}", e.what()));
+      }
+    }
+    if (!header)
+      throw io::IoError(fmt::format("{}: no valid checkpoint to resume from{}", checkpoint_dir(options.out_dir).string(),
+                                    summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
+    sim.resume(header->step);
+    summary.first_step = header->step;
+    const auto frames = static_cast<std::size_t>(value_of(values, "frames", 0));
+    writer.resume(frames);
+    if (diagnostics) diagnostics->resume(frames);  // one row per frame
+    next_frame = static_cast<std::uint64_t>(value_of(values, "next_frame", 1));
+    last_frame_step = static_cast<std::uint64_t>(value_of(values, "last_frame_step", 0));
+    next_checkpoint = static_cast<std::uint64_t>(value_of(values, "next_checkpoint", 1));
+    initial_energy = value_of(values, "initial_energy", initial_energy);
+    neighbor_sum = value_of(values, "neighbor_sum", 0);
+    nodes_sum = value_of(values, "nodes_sum", 0);
+  } else {
+    io::write_file_atomic(options.out_dir / "scene.toml", scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
+  }
+
+  std::uint64_t target = scene.total_steps();
+  if (options.until) target = steps_until(*options.until, scene.dt);
+  if (options.steps) target = summary.first_step + *options.steps;
+
   const auto started = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(); };
   auto write_frame = [&] {
     ScopedPhase phase(sim.timers(), "output");
     writer.write(sim.particles(), sim.time());
+    last_frame_step = sim.step_count();
     if (fluid) {
       const auto d = sph::fluid_diagnostics(sim.particles(), scene.gravity, scene.sph->rest_density, scene.block_size);
       diagnostics->add({sim.time(), d.kinetic_energy, d.potential_energy, d.momentum.x, d.momentum.y, d.momentum.z,
                         d.mean_density_error, d.max_density_error, fluid->mean_neighbors()});
     } else if (self_gravity) {
       const auto d = gravity::diagnose(sim.particles(), scene.block_size);
-      if (!initial_energy) initial_energy = d.total;
-      energy_error = *initial_energy != 0 ? (d.total - *initial_energy) / std::abs(*initial_energy) : 0.0;
+      if (std::isnan(initial_energy)) initial_energy = d.total;
+      energy_error = initial_energy != 0 ? (d.total - initial_energy) / std::abs(initial_energy) : 0.0;
       diagnostics->add({sim.time(), d.kinetic, d.potential, d.total, energy_error, d.momentum.x, d.momentum.y,
                         d.momentum.z, d.angular_momentum.x, d.angular_momentum.y, d.angular_momentum.z, d.virial_ratio,
                         self_gravity->stats().mean_nodes_visited});
     }
   };
-  double neighbor_sum = 0, nodes_sum = 0;  // per-evaluation means, summed for the summary
+  auto write_checkpoint = [&] {
+    ScopedPhase phase(sim.timers(), "output");
+    const io::CheckpointValues values{{"frames", double(writer.frames())},
+                                      {"next_frame", double(next_frame)},
+                                      {"last_frame_step", double(last_frame_step)},
+                                      {"next_checkpoint", double(next_checkpoint)},
+                                      {"initial_energy", initial_energy},
+                                      {"neighbor_sum", neighbor_sum},
+                                      {"nodes_sum", nodes_sum}};
+    std::filesystem::create_directories(checkpoint_dir(options.out_dir));
+    const auto file = checkpoint_dir(options.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count());
+    io::write_checkpoint(file, sim.particles(), {sizeof(Real), sim.particles().size(), hash, sim.step_count(), sim.time()},
+                         values);
+    summary.last_checkpoint = file;
+    const auto files = checkpoints_in(options.out_dir);
+    for (std::size_t k = std::max<std::size_t>(options.checkpoint_keep, 1); k < files.size(); ++k)
+      std::filesystem::remove(files[k]);
+  };
 
   // Frame k is due at the first step with time ≥ k·interval; the slack keeps
-  // k·interval that lands on a step (up to rounding) on that step.
+  // k·interval that lands on a step (up to rounding) on that step. Checkpoints
+  // by time follow the same rule.
   const double interval = scene.output_interval;
   const double slack = 1e-9 * scene.dt;
-  std::uint64_t next_frame = 1;
-  sim.start();  // force models add their fields (density, potential) here
-  summary.bytes_per_particle = bytes_per_particle(sim.particles());
-  write_frame();
-  bool last_written = true;
-  if (on_progress) on_progress({0, total, 0.0, wall()});
+  auto due = [&](double every, std::uint64_t k) { return sim.time() + slack >= static_cast<double>(k) * every; };
+  auto after = [&](double every) { return static_cast<std::uint64_t>(std::floor((sim.time() + slack) / every)) + 1; };
   try {
-    for (std::uint64_t s = 0; s < total; ++s) {
+    if (!options.resume) {
+      sim.start();  // force models add their fields (density, potential) here
+      write_frame();
+    }
+    summary.bytes_per_particle = bytes_per_particle(sim.particles());
+    if (on_progress) on_progress({sim.step_count(), target, sim.time(), wall()});
+    while (sim.step_count() < target) {
       sim.step();
       if (fluid) neighbor_sum += fluid->mean_neighbors();
       if (self_gravity) nodes_sum += self_gravity->stats().mean_nodes_visited;
-      last_written = false;
-      if (interval > 0 && sim.time() + slack >= static_cast<double>(next_frame) * interval) {
+      if (interval > 0 && due(interval, next_frame)) {
         write_frame();
-        last_written = true;
-        next_frame = static_cast<std::uint64_t>(std::floor((sim.time() + slack) / interval)) + 1;
+        next_frame = after(interval);
       }
-      if (on_progress) on_progress({sim.step_count(), total, sim.time(), wall()});
+      bool checkpoint = options.checkpoint_every_steps && sim.step_count() % *options.checkpoint_every_steps == 0;
+      if (options.checkpoint_every && due(*options.checkpoint_every, next_checkpoint)) {
+        next_checkpoint = after(*options.checkpoint_every);
+        checkpoint = true;
+      }
+      const bool stopping = options.stop && options.stop->load();
+      if (checkpoint || stopping) write_checkpoint();
+      if (on_progress) on_progress({sim.step_count(), target, sim.time(), wall()});
+      if (stopping) {
+        summary.interrupted = true;
+        break;
+      }
     }
-    if (!last_written) write_frame();
+    if (!summary.interrupted && last_frame_step != sim.step_count()) write_frame();
   } catch (const SimulationError& e) {
     summary.error = e.what();
   } catch (const io::IoError& e) {
     summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
+  } catch (const std::filesystem::filesystem_error& e) {
+    summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
   }
 
-  summary.steps = sim.step_count();
+  summary.steps = sim.step_count() - summary.first_step;
   summary.sim_time = sim.time();
   summary.wall_seconds = wall();
   summary.steps_per_second = summary.wall_seconds > 0 ? static_cast<double>(summary.steps) / summary.wall_seconds : 0;
   summary.phases = sim.timers().phases();
   summary.frames = writer.frames();
-  const double evaluations = static_cast<double>(summary.steps);
+  const double evaluations = static_cast<double>(sim.step_count());
   if (fluid)
     summary.metrics.emplace_back("mean_neighbours", evaluations > 0 ? neighbor_sum / evaluations : fluid->mean_neighbors());
   if (self_gravity) {

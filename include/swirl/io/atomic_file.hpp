@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <string>
 #include <string_view>
 
 namespace swirl::io {
@@ -20,6 +21,9 @@ class IoError : public std::runtime_error {
 // On failure the temporary file is removed, `path` is untouched and IoError is
 // thrown.
 void write_file_atomic(const std::filesystem::path& path, std::string_view bytes, bool sync = false);
+
+// The whole content of a file; IoError naming the file if it cannot be read.
+std::string read_text_file(const std::filesystem::path& path);
 
 // Throws IoError unless `dir` exists (it is created if missing) and a file can
 // be created in it.

@@ -75,6 +75,8 @@ using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, Ste
 
 struct Scene {
   std::string file;                        // where it came from, for messages
+  std::string toml;                        // the scene as TOML after --set overrides (parse_scene fills
+                                           // it): saved beside a run's outputs so it can be resumed
   Precision precision = Precision::Float;  // simulation.precision, default "float"
   double dt = 0;                           // simulation.dt, s, > 0
   std::optional<double> end_time;          // simulation.end_time, s (exactly one of end_time, steps)

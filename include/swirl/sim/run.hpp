@@ -10,6 +10,7 @@
 // kinetic and potential energy, momentum, density errors and mean neighbours.
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -26,7 +27,23 @@ namespace swirl::sim {
 struct RunOptions {
   std::filesystem::path out_dir = "out";
   int threads = 0;                      // 0: OpenMP's default (OMP_NUM_THREADS or all cores)
-  std::optional<std::uint64_t> steps;   // replaces the scene's step count
+  std::optional<std::uint64_t> steps;   // steps to take (from the start, or from the checkpoint on resume)
+  std::optional<double> until;          // run until this simulated time instead of the scene's end
+
+  // Checkpoints in out_dir/checkpoints/ (see io/checkpoint.hpp), every
+  // `checkpoint_every` of simulated time and/or every `checkpoint_every_steps`
+  // steps; the newest `checkpoint_keep` are kept.
+  std::optional<double> checkpoint_every;
+  std::optional<std::uint64_t> checkpoint_every_steps;
+  std::size_t checkpoint_keep = 2;
+
+  // Continue the run in out_dir from its newest valid checkpoint (the scene
+  // must be the one saved there, out_dir/scene.toml).
+  bool resume = false;
+
+  // When set (by a signal handler), the run stops after the current step,
+  // writes a checkpoint and returns with RunSummary::interrupted.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 // Reported after start() and after every step.
@@ -53,11 +70,17 @@ struct RunSummary {
   // Solver figures, e.g. {"mean_neighbours", 24.9} for SPH runs (mean over steps).
   std::vector<std::pair<std::string, double>> metrics;
   std::string error;                    // empty when the run completed
+  bool interrupted = false;             // stopped by RunOptions::stop (a checkpoint was written)
+  std::uint64_t first_step = 0;         // 0, or the checkpoint's step when resumed
+  std::filesystem::path last_checkpoint;  // the newest checkpoint written or resumed from
+  std::vector<std::string> warnings;    // e.g. a corrupt checkpoint skipped on resume
 };
 
 // Runs the scene. Throws io::IoError before doing any work if out_dir cannot be
-// written. A blow-up during the run stops it, keeps every frame already
-// written, and is reported in RunSummary::error.
+// written (or, on resume, holds no valid checkpoint of this scene). A blow-up
+// or a write failure during the run stops it, keeps every frame and checkpoint
+// already written, and is reported in RunSummary::error. The effective scene is
+// saved as out_dir/scene.toml.
 RunSummary run_scene(const scene::Scene& scene, const RunOptions& options,
                      const std::function<void(const RunProgress&)>& on_progress = {});
 

@@ -82,6 +82,15 @@ class Simulation {
     started_ = true;
   }
 
+  // Continues from a restored state instead of start(): the particles hold every
+  // field as it was after step `step` (a checkpoint), so the next step() is the
+  // one the original run would have taken.
+  void resume(std::uint64_t step) {
+    step_count_ = step;
+    outside_before_.assign(particles_.size(), 0);
+    started_ = true;
+  }
+
   // Advances the state by one time step (see the header comment).
   void step() {
     if (!started_) throw std::logic_error("Simulation::step() before start()");

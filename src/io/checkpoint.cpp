@@ -1,0 +1,226 @@
+#include "swirl/io/checkpoint.hpp"
+
+#include <bit>
+#include <cstring>
+#include <limits>
+#include <string_view>
+
+#include <fmt/format.h>
+
+#include "detail.hpp"
+#include "swirl/io/atomic_file.hpp"
+
+namespace swirl::io {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "checkpoints are written little-endian");
+
+constexpr std::string_view kMagic = "SWIRLCKP";
+constexpr std::uint32_t kMaxName = 256, kMaxFields = 64, kMaxValues = 64;
+constexpr std::uint64_t kMaxParticles = std::uint64_t{1} << 31;
+
+std::uint64_t fnv1a(std::string_view bytes) {
+  std::uint64_t h = 0xcbf29ce484222325u;
+  for (const char c : bytes) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 0x100000001b3u;
+  }
+  return h;
+}
+
+template <class T>
+void put(std::string& out, T value) {
+  char raw[sizeof(T)];
+  std::memcpy(raw, &value, sizeof(T));
+  out.append(raw, sizeof(T));
+}
+
+void put_name(std::string& out, std::string_view name) {
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(name.size()));
+  out.append(name);
+}
+
+// Reads fixed-size values from the bytes, never past their end.
+class Cursor {
+ public:
+  explicit Cursor(std::string_view bytes) : bytes_(bytes) {}
+  template <class T>
+  T get(std::string_view what) {
+    T v;
+    std::memcpy(&v, take(sizeof(T), what).data(), sizeof(T));
+    return v;
+  }
+  std::string_view take(std::size_t n, std::string_view what) {
+    if (n > bytes_.size() - pos_) throw detail::Malformed(fmt::format("truncated in {}", what));
+    const auto out = bytes_.substr(pos_, n);
+    pos_ += n;
+    return out;
+  }
+  std::string name(std::string_view what) {
+    const auto n = get<std::uint32_t>(what);
+    if (n == 0 || n > kMaxName) throw detail::Malformed(fmt::format("{} has a bad name length {}", what, n));
+    return std::string(take(n, what));
+  }
+  std::size_t remaining() const { return bytes_.size() - pos_; }
+
+ private:
+  std::string_view bytes_;
+  std::size_t pos_ = 0;
+};
+
+CheckpointHeader parse_header(Cursor& in) {
+  if (in.take(kMagic.size(), "the magic") != kMagic) throw detail::Malformed("not a swirl checkpoint (bad magic)");
+  const auto version = in.get<std::uint32_t>("the version");
+  if (version != kCheckpointVersion)
+    throw detail::Malformed(fmt::format("format version {} is not supported: this swirl reads version {} only{}",
+                                        version, kCheckpointVersion,
+                                        version < kCheckpointVersion ? " (written by an older swirl)" : ""));
+  CheckpointHeader h;
+  h.real_bytes = in.get<std::uint32_t>("the precision");
+  if (h.real_bytes != 4 && h.real_bytes != 8)
+    throw detail::Malformed(fmt::format("bad precision: {} bytes per real", h.real_bytes));
+  h.particles = in.get<std::uint64_t>("the particle count");
+  if (h.particles > kMaxParticles) throw detail::Malformed(fmt::format("{} particles is over the limit", h.particles));
+  h.scene_hash = in.get<std::uint64_t>("the scene hash");
+  h.step = in.get<std::uint64_t>("the step");
+  h.time = in.get<double>("the time");
+  return h;
+}
+
+template <class Real>
+CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, CheckpointValues& values) {
+  if (bytes.size() < kMagic.size() + 8) throw detail::Malformed("too short to be a checkpoint");
+  // The checksum first: whatever follows reads only bytes that were written as they are.
+  std::uint64_t stored;
+  std::memcpy(&stored, bytes.data() + bytes.size() - 8, 8);
+  const std::string_view body = bytes.substr(0, bytes.size() - 8);
+  Cursor in(body);
+  const CheckpointHeader h = parse_header(in);  // a clear "version" or "magic" message beats "checksum"
+  if (fnv1a(body) != stored) throw detail::Malformed("checksum mismatch: the file is corrupt or truncated");
+  if (h.real_bytes != sizeof(Real))
+    throw detail::Malformed(fmt::format("holds {}-byte reals, the run uses {}-byte ones", h.real_bytes, sizeof(Real)));
+
+  const auto field_count = in.get<std::uint32_t>("the field count");
+  if (field_count == 0 || field_count > kMaxFields) throw detail::Malformed(fmt::format("bad field count {}", field_count));
+  std::vector<std::pair<std::string, std::uint32_t>> fields;
+  std::uint64_t reals_per_particle = 0;
+  for (std::uint32_t f = 0; f < field_count; ++f) {
+    auto name = in.name("a field name");
+    const auto components = in.get<std::uint32_t>("a field's components");
+    if (components != 1 && components != 3)
+      throw detail::Malformed(fmt::format("field '{}' has {} components", name, components));
+    reals_per_particle += components;
+    fields.emplace_back(std::move(name), components);
+  }
+  const auto value_count = in.get<std::uint32_t>("the value count");
+  if (value_count > kMaxValues) throw detail::Malformed(fmt::format("bad value count {}", value_count));
+  CheckpointValues read_values;
+  for (std::uint32_t v = 0; v < value_count; ++v) {
+    auto name = in.name("a value name");
+    read_values.emplace_back(std::move(name), in.get<double>("a value"));
+  }
+  // The data must fill the rest exactly: checked before anything is allocated.
+  const std::uint64_t expected = h.particles * (reals_per_particle * sizeof(Real) + sizeof(std::uint64_t));
+  if (in.remaining() != expected)
+    throw detail::Malformed(fmt::format("holds {} bytes of particle data, {} particles need {}", in.remaining(),
+                                        h.particles, expected));
+
+  const std::size_t n = static_cast<std::size_t>(h.particles);
+  particles.resize(n);
+  for (const auto& [name, components] : fields) {
+    if (name != "position" && name != "velocity" && name != "acceleration" && name != "acceleration_prev" &&
+        name != "mass" && name != "density" && name != "pressure")
+      particles.add_field(name, static_cast<int>(components));
+  }
+  auto views = particles.fields();
+  for (const auto& [name, components] : fields) {
+    FieldView<Real>* view = nullptr;
+    for (auto& v : views)
+      if (v.name == name) view = &v;
+    if (!view || view->components != static_cast<int>(components))
+      throw detail::Malformed(fmt::format("field '{}' does not match the run's fields", name));
+    for (int c = 0; c < view->components; ++c) {
+      const auto raw = in.take(n * sizeof(Real), name);
+      if (n) std::memcpy(view->data[c], raw.data(), raw.size());
+    }
+  }
+  const auto ids = in.take(n * sizeof(std::uint64_t), "the ids");
+  if (n) std::memcpy(particles.id.data(), ids.data(), ids.size());
+  values = std::move(read_values);
+  return h;
+}
+
+}  // namespace
+
+template <class Real>
+void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>& particles,
+                      const CheckpointHeader& header, const CheckpointValues& values) {
+  std::string out;
+  const auto fields = particles.fields();
+  std::size_t data = particles.size() * sizeof(std::uint64_t);
+  for (const auto& f : fields) data += static_cast<std::size_t>(f.components) * particles.size() * sizeof(Real);
+  out.reserve(data + 4096);
+  out.append(kMagic);
+  put<std::uint32_t>(out, kCheckpointVersion);
+  put<std::uint32_t>(out, sizeof(Real));
+  put<std::uint64_t>(out, particles.size());
+  put<std::uint64_t>(out, header.scene_hash);
+  put<std::uint64_t>(out, header.step);
+  put<double>(out, header.time);
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(fields.size()));
+  for (const auto& f : fields) {
+    put_name(out, f.name);
+    put<std::uint32_t>(out, static_cast<std::uint32_t>(f.components));
+  }
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(values.size()));
+  for (const auto& [name, value] : values) {
+    put_name(out, name);
+    put<double>(out, value);
+  }
+  for (const auto& f : fields)
+    for (int c = 0; c < f.components; ++c)
+      out.append(reinterpret_cast<const char*>(f.data[c]), particles.size() * sizeof(Real));
+  out.append(reinterpret_cast<const char*>(particles.id.data()), particles.size() * sizeof(std::uint64_t));
+  put<std::uint64_t>(out, fnv1a(out));
+  write_file_atomic(path, out, /*sync=*/true);
+}
+
+template <class Real>
+CheckpointHeader parse_checkpoint(std::string_view bytes, std::string_view name, ParticleSet<Real>& particles,
+                                  CheckpointValues& values) {
+  try {
+    return parse(bytes, particles, values);
+  } catch (const detail::Malformed& e) {
+    throw IoError(fmt::format("{}: {}", name, e.what()));
+  }
+}
+
+template <class Real>
+CheckpointHeader read_checkpoint(const std::filesystem::path& path, ParticleSet<Real>& particles,
+                                 CheckpointValues& values) {
+  return parse_checkpoint(detail::read_file(path), path.string(), particles, values);
+}
+
+CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
+  const std::string bytes = detail::read_file(path);
+  try {
+    Cursor in(bytes);
+    return parse_header(in);
+  } catch (const detail::Malformed& e) {
+    throw IoError(fmt::format("{}: {}", path.string(), e.what()));
+  }
+}
+
+template void write_checkpoint<float>(const std::filesystem::path&, const ParticleSet<float>&, const CheckpointHeader&,
+                                      const CheckpointValues&);
+template void write_checkpoint<double>(const std::filesystem::path&, const ParticleSet<double>&,
+                                       const CheckpointHeader&, const CheckpointValues&);
+template CheckpointHeader read_checkpoint<float>(const std::filesystem::path&, ParticleSet<float>&, CheckpointValues&);
+template CheckpointHeader read_checkpoint<double>(const std::filesystem::path&, ParticleSet<double>&,
+                                                  CheckpointValues&);
+template CheckpointHeader parse_checkpoint<float>(std::string_view, std::string_view, ParticleSet<float>&,
+                                                  CheckpointValues&);
+template CheckpointHeader parse_checkpoint<double>(std::string_view, std::string_view, ParticleSet<double>&,
+                                                   CheckpointValues&);
+
+}  // namespace swirl::io

@@ -1,0 +1,128 @@
+// Runs that survive: checkpoint and bit-exact resume, signals, disk trouble.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+#include "cli_support.hpp"
+#include "swirl/io/pvd.hpp"
+#include "swirl/io/vtp.hpp"
+
+namespace {
+
+const std::string kExamples = std::string(SWIRL_SOURCE_DIR) + "/examples/";
+// A small dam break (a coarse block) and a small Plummer sphere.
+const std::string kSph = kExamples + "dam_break.toml --set particles.0.spacing=0.03 --set output.interval=0.004";
+const std::string kGravity = kExamples + "plummer.toml --set particles.0.count=400 --set output.interval=0.125";
+
+// Every output file of a finished run (frames, series, diagnostics), compared byte for byte.
+void expect_same_outputs(const fs::path& a, const fs::path& b) {
+  std::size_t compared = 0;
+  for (const auto& e : fs::directory_iterator(a)) {
+    const auto name = e.path().filename().string();
+    if (e.is_directory() || name == "scene.toml") continue;
+    ASSERT_TRUE(fs::exists(b / name)) << name;
+    EXPECT_TRUE(slurp(e.path()) == slurp(b / name)) << name << " differs";
+    ++compared;
+  }
+  EXPECT_GE(compared, 4u);
+}
+
+class Restart : public Cli {};
+
+TEST_F(Restart, SphResumedWithOtherThreadsEndsBitIdentical) {
+  ASSERT_EQ(swirl("run " + kSph + " --steps 30 --threads 2 --out " + (dir_ / "a").string()).status, 0);
+  ASSERT_EQ(swirl("run " + kSph + " --steps 12 --threads 2 --checkpoint-every-steps 6 --out " + (dir_ / "b").string()).status, 0);
+  const auto r = swirl("run --resume " + (dir_ / "b").string() + " --steps 18 --threads 1");
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_same_outputs(dir_ / "a", dir_ / "b");
+}
+
+TEST_F(Restart, GravityResumedByTimeEndsBitIdentical) {
+  ASSERT_EQ(swirl("run " + kGravity + " --until 0.5 --threads 1 --out " + (dir_ / "a").string()).status, 0);
+  ASSERT_EQ(swirl("run " + kGravity + " --until 0.25 --threads 1 --checkpoint-every 0.1 --out " + (dir_ / "b").string()).status, 0);
+  const auto r = swirl("run --resume " + (dir_ / "b").string() + " --until 0.5 --threads 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_same_outputs(dir_ / "a", dir_ / "b");
+}
+
+TEST_F(Restart, ACorruptOrTruncatedCheckpointFallsBackToThePreviousOne) {
+  ASSERT_EQ(swirl("run " + kSph + " --steps 30 --out " + (dir_ / "a").string()).status, 0);
+  ASSERT_EQ(swirl("run " + kSph + " --steps 12 --checkpoint-every-steps 4 --checkpoint-keep 3 --out " + (dir_ / "b").string()).status, 0);
+  const auto ckpt = dir_ / "b" / "checkpoints";
+  // Keep 3: steps 4, 8 and 12. Truncate the newest, flip a byte in the next.
+  const auto newest = ckpt / "checkpoint_000000000012.swc", middle = ckpt / "checkpoint_000000000008.swc";
+  ASSERT_TRUE(fs::exists(ckpt / "checkpoint_000000000004.swc"));
+  fs::resize_file(newest, fs::file_size(newest) / 2);
+  std::string bytes = slurp(middle);
+  bytes[bytes.size() / 2] = static_cast<char>(bytes[bytes.size() / 2] ^ 1);
+  std::ofstream(middle, std::ios::binary) << bytes;
+  const auto r = swirl("run --resume " + (dir_ / "b").string() + " --steps 26");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: skipping checkpoint: " + newest.string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("checksum"), std::string::npos) << r.err;
+  expect_same_outputs(dir_ / "a", dir_ / "b");
+}
+
+TEST_F(Restart, ResumeRefusesWhatItCannotUse) {
+  auto r = swirl("run --resume " + (dir_ / "nothing").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("scene.toml"), std::string::npos) << r.err;
+  ASSERT_EQ(swirl("run " + kSph + " --steps 3 --out " + (dir_ / "b").string()).status, 0);
+  r = swirl("run --resume " + (dir_ / "b").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("no valid checkpoint"), std::string::npos) << r.err;
+}
+
+// A child run interrupted by SIGINT writes a checkpoint, says how to resume and
+// exits 130; resumed, it ends as the uninterrupted run.
+TEST_F(Restart, SigintCheckpointsAndResumeMatchesTheUninterruptedRun) {
+  const std::string uninterrupted = (dir_ / "a").string(), interrupted = (dir_ / "b").string();
+  ASSERT_EQ(swirl("run " + kGravity + " --steps 200 --out " + uninterrupted).status, 0);
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const std::string cmd = std::string(SWIRL_CLI) + " run " + kGravity + " --steps 200 --out " + interrupted + " >" +
+                            (dir_ / "child.out").string() + " 2>" + (dir_ / "child.err").string();
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until the run is under way (its first frame exists), then interrupt it.
+  for (int k = 0; k < 2000 && !fs::exists(dir_ / "b" / "particles_000001.vtp"); ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  kill(child, SIGINT);
+  int status = 0;
+  waitpid(child, &status, 0);
+  const std::string err = slurp(dir_ / "child.err");
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) GTEST_SKIP() << "the run finished before the signal arrived";
+  ASSERT_TRUE(WIFEXITED(status)) << err;
+  EXPECT_EQ(WEXITSTATUS(status), 130) << err;
+  EXPECT_NE(err.find("resume with: swirl run --resume " + interrupted), std::string::npos) << err;
+  const auto r = swirl("run --resume " + interrupted + " --until 3.125");  // 200 steps of 1/64
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_same_outputs(dir_ / "a", dir_ / "b");
+}
+
+// The disk fills up mid-run (a 600 KB tmpfs, frames of ~176 KB): the run stops
+// with a message and exit status 1, and every frame written before is intact.
+TEST_F(Restart, AFullDiskMidRunKeepsTheEarlierFrames) {
+  const auto disk = dir_ / "disk";
+  fs::create_directories(disk);
+  if (std::system(("mount -t tmpfs -o size=600k tmpfs " + disk.string() + " 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs here (needs root)";
+  const auto r = swirl("run " + kSph + " --steps 100 --checkpoint-every-steps 50 --out " + (disk / "run").string());
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("writing output failed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+  const auto frames = swirl::io::read_pvd(disk / "run" / "particles.pvd");
+  EXPECT_GE(frames.size(), 1u);
+  for (const auto& f : frames) EXPECT_GT(swirl::io::read_vtp(disk / "run" / f.file).num_points, 0u) << f.file;
+  for (const auto& e : fs::directory_iterator(disk / "run"))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << "left-over " << e.path();
+  EXPECT_EQ(std::system(("umount " + disk.string()).c_str()), 0);
+}
+
+}  // namespace
