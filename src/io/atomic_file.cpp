@@ -101,7 +101,7 @@ void write_file_atomic(const fs::path& path, std::string_view bytes, bool sync) 
   if (sync) sync_directory(path);
 }
 
-void ensure_writable_directory(const fs::path& dir) {
+void ensure_writable_directory(const fs::path& dir, std::uintmax_t bytes_needed) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw IoError(fmt::format("{}: cannot create directory: {}", dir.string(), ec.message()));
@@ -111,6 +111,10 @@ void ensure_writable_directory(const fs::path& dir) {
   TempFile probe(unique_sibling(dir / "probe", "writable"));
   if (probe.open() < 0) fail(dir, "directory is not writable", errno);
   if (probe.close() != 0) fail(dir, "directory is not writable (close failed)", errno);
+  const auto space = fs::space(dir, ec);
+  if (!ec && space.available < bytes_needed)
+    throw IoError(fmt::format("{}: the disk is full: {} bytes free, the run needs about {} for its first outputs",
+                              dir.string(), space.available, bytes_needed));
 }
 
 std::string read_text_file(const std::filesystem::path& path) { return detail::read_file(path); }

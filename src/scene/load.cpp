@@ -519,7 +519,8 @@ void read_sph(const Table& top, Scene& s) {
   const bool has_h = t.find("smoothing_length") != nullptr, has_k = t.find("neighbours") != nullptr;
   if (has_h && has_k) t.fail("neighbours", fmt::format("cannot be given together with {}", t.key("smoothing_length")));
   if (has_h) {
-    p.smoothing_length = t.number("smoothing_length", {}, kPositive);
+    // A support radius beyond 1e9 m is a typo; it would also overflow h³.
+    p.smoothing_length = t.number("smoothing_length", {}, Range{0, 1e9, true, false});
   } else {
     const double k = t.number("neighbours", {}, Range{0, 10000, true, false});
     // The spacing of the first fluid block sets the volume per particle.

@@ -7,6 +7,8 @@
 #include <memory>
 #include <sstream>
 
+#include <unistd.h>
+
 #include <fmt/format.h>
 
 #include "swirl/io/atomic_file.hpp"
@@ -289,11 +291,44 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   return summary;
 }
 
+// Memory and disk a scene needs, estimated before anything is allocated.
+struct Footprint {
+  double memory = 0;  // bytes: particle fields, solver scratch, neighbour lists
+  double frame = 0;   // bytes of one .vtp frame
+};
+
+Footprint footprint(const scene::Scene& scene) {
+  const double n = static_cast<double>(scene::count_particles(scene));
+  const double real = scene.precision == scene::Precision::Float ? 4 : 8;
+  // 16 reals and an id of fields; the scene's double copy while building; SPH
+  // hash, sorted copies and ~40 neighbours of (index, r²) twice (block lists
+  // and the CSR); tree nodes for gravity.
+  double per_particle = 16 * real + 8 + 56;
+  if (scene.sph) per_particle += 40 + 2 * 40 * (4 + real);
+  if (scene.nbody) per_particle += 2 * 96;
+  return {n * per_particle, n * (16 * real + 8 + 16) + 4096};
+}
+
+std::uint64_t memory_available() {
+  const long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+  return pages > 0 && size > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(size) : 0;
+}
+
 }  // namespace
+
+void check_resources(const scene::Scene& scene, const std::filesystem::path& out_dir) {
+  const Footprint f = footprint(scene);
+  const std::uint64_t available = memory_available();
+  if (available > 0 && f.memory > 0.9 * static_cast<double>(available))
+    throw std::invalid_argument(fmt::format(
+        "{}: {} particles need about {:.1f} GB of memory, more than the {:.1f} GB this machine has free",
+        scene.file, scene::count_particles(scene), f.memory / 1e9, static_cast<double>(available) / 1e9));
+  io::ensure_writable_directory(out_dir, static_cast<std::uintmax_t>(f.frame));
+}
 
 RunSummary run_scene(const scene::Scene& scene, const RunOptions& options,
                      const std::function<void(const RunProgress&)>& on_progress) {
-  io::ensure_writable_directory(options.out_dir);
+  check_resources(scene, options.out_dir);
   if (options.threads > 0) parallel::set_thread_count(options.threads);
   return scene.precision == scene::Precision::Float ? run_typed<float>(scene, options, on_progress)
                                                     : run_typed<double>(scene, options, on_progress);

@@ -125,4 +125,37 @@ TEST_F(Restart, AFullDiskMidRunKeepsTheEarlierFrames) {
   EXPECT_EQ(std::system(("umount " + disk.string()).c_str()), 0);
 }
 
+// A disk already too full for the first frame is refused before running.
+TEST_F(Restart, AFullDiskAtStartIsRefusedBeforeRunning) {
+  const auto disk = dir_ / "disk";
+  fs::create_directories(disk);
+  if (std::system(("mount -t tmpfs -o size=200k tmpfs " + disk.string() + " 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "cannot mount a tmpfs here (needs root)";
+  std::system(("dd if=/dev/zero of=" + (disk / "filler").string() + " bs=1k count=150 2>/dev/null").c_str());
+  const auto r = swirl("run " + kSph + " --steps 5 --out " + (disk / "run").string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("the disk is full"), std::string::npos) << r.err;
+  EXPECT_EQ(r.out.find("steps per second"), std::string::npos) << r.out;
+  EXPECT_EQ(std::system(("umount " + disk.string()).c_str()), 0);
+}
+
+// Hostile sizes are refused before anything is allocated or written.
+TEST_F(Restart, ScenesBeyondMemoryOrSenseAreRefusedUpFront) {
+  auto r = swirl("run " + kExamples + "random_box.toml --set particles=2000000000 --out " + (dir_ / "m").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("2000000000 particles need about"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("GB of memory, more than the"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "m"));
+  r = swirl("run " + kExamples + "random_box.toml --set sph.smoothing_length=1e300 --out " + (dir_ / "h").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("sph.smoothing_length: must be in (0, 1000000000], got 1e+300"), std::string::npos) << r.err;
+  r = swirl("run " + kExamples + "random_box.toml --set simulation.dt=0 --out " + (dir_ / "h").string());
+  EXPECT_NE(r.err.find("simulation.dt: must be > 0, got 0"), std::string::npos) << r.err;
+  r = swirl("run " + kExamples + "falling_block.toml --set particles.0.mass=-1 --out " + (dir_ / "h").string());
+  EXPECT_NE(r.err.find("particles[0].mass: must be > 0, got -1"), std::string::npos) << r.err;
+  r = swirl("run " + kExamples + "falling_block.toml --set box.restitution=nan --out " + (dir_ / "h").string());
+  EXPECT_NE(r.err.find("box.restitution: must be finite, got nan"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "h"));
+}
+
 }  // namespace

@@ -3,6 +3,7 @@
 // target (rename is atomic within one file system).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -25,8 +26,9 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view bytes
 // The whole content of a file; IoError naming the file if it cannot be read.
 std::string read_text_file(const std::filesystem::path& path);
 
-// Throws IoError unless `dir` exists (it is created if missing) and a file can
-// be created in it.
-void ensure_writable_directory(const std::filesystem::path& dir);
+// Throws IoError unless `dir` exists (it is created if missing), a file can be
+// created in it, and its file system has at least `bytes_needed` bytes free
+// (the message then gives both figures).
+void ensure_writable_directory(const std::filesystem::path& dir, std::uintmax_t bytes_needed = 0);
 
 }  // namespace swirl::io

@@ -76,7 +76,13 @@ struct RunSummary {
   std::vector<std::string> warnings;    // e.g. a corrupt checkpoint skipped on resume
 };
 
-// Runs the scene. Throws io::IoError before doing any work if out_dir cannot be
+// Refuses, before anything is allocated or run, a scene whose particles would
+// not fit in the free memory (std::invalid_argument with the estimate and the
+// limit) or an output directory that cannot be written or has no room for the
+// first outputs (io::IoError).
+void check_resources(const scene::Scene& scene, const std::filesystem::path& out_dir);
+
+// Runs the scene (after check_resources). Throws io::IoError before doing any work if out_dir cannot be
 // written (or, on resume, holds no valid checkpoint of this scene). A blow-up
 // or a write failure during the run stops it, keeps every frame and checkpoint
 // already written, and is reported in RunSummary::error. The effective scene is
