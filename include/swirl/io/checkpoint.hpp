@@ -14,7 +14,11 @@
 // Fields are every real field of the ParticleSet (positions, velocities,
 // accelerations, previous accelerations, mass, density, pressure, solver
 // fields such as "potential"); "values" carry run and solver state (frames
-// written, the next output time, the initial energy, ...). Whoever adds state
+// written, the next output time, the initial energy, ...). No solver holds
+// state that changes results today: SPH rebuilds its hash and lists every step,
+// and the gravity sub-domain load balance (nodes explored last step) decides
+// only which thread walks which tree, never a particle's summation order, so a
+// resumed run is bit-identical without it (tested). Whoever adds state
 // that changes results adds it here and bumps kCheckpointVersion; older
 // versions are refused with a message saying so.
 #pragma once
