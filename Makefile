@@ -4,7 +4,8 @@
 #   make test   install what is missing, build, run every test with CTest
 #
 # Other targets: build, asan-test (tests under AddressSanitizer+UBSan, long
-# tests skipped), debug, clean, deps.
+# tests skipped), tsan-test (the parallel tests under ThreadSanitizer), debug,
+# clean, deps.
 
 PRESET   ?= release
 JOBS     ?= $(shell nproc)
@@ -18,7 +19,7 @@ DEB_PACKAGES := cmake ninja-build g++ make git pkg-config \
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps configure build test demo asan-test debug clean
+.PHONY: all deps configure build test demo asan-test tsan-test debug clean
 
 all: build
 
@@ -51,9 +52,12 @@ asan-test: deps
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan
 
+tsan-test: deps
+	bash .ci/tsan.sh
+
 debug: deps
 	cmake --preset debug
 	cmake --build --preset debug -j $(JOBS)
 
 clean:
-	rm -rf build build-debug build-asan build-portable out
+	rm -rf build build-debug build-asan build-tsan build-fuzz build-portable out

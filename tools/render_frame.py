@@ -3,8 +3,9 @@
 
 Usage: render_frame.py FRAME.vtp OUT.png [--box xmin ymin zmin xmax ymax zmax] [--title TEXT]
 Needs Debian's python3-vtk9 and python3-matplotlib. Used for the README picture:
-  build/swirl run examples/falling_block.toml --out out/demo
-  tools/render_frame.py out/demo/particles_000018.vtp docs/images/falling_block.png --box 0 0 0 1 1 1
+  make demo
+  tools/render_frame.py out/demo/particles_000020.vtp docs/images/dam_break.png --box 0 0 0 1 0.5 0.6
+  (falling_block.png: examples/falling_block.toml, frame 18, --box 0 0 0 1 1 1)
 """
 import argparse
 
