@@ -3,6 +3,7 @@
 #include <bit>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 #include <string_view>
 
 #include <fmt/format.h>
@@ -106,6 +107,9 @@ CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, Che
   std::uint64_t reals_per_particle = 0;
   for (std::uint32_t f = 0; f < field_count; ++f) {
     auto name = in.name("a field name");
+    for (const auto& [seen, c] : fields)
+      if (seen == name) throw detail::Malformed(fmt::format("field '{}' is listed twice", name));
+    if (name == "id") throw detail::Malformed("a field may not be called 'id'");
     const auto components = in.get<std::uint32_t>("a field's components");
     if (components != 1 && components != 3)
       throw detail::Malformed(fmt::format("field '{}' has {} components", name, components));
@@ -128,9 +132,14 @@ CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, Che
   const std::size_t n = static_cast<std::size_t>(h.particles);
   particles.resize(n);
   for (const auto& [name, components] : fields) {
-    if (name != "position" && name != "velocity" && name != "acceleration" && name != "acceleration_prev" &&
-        name != "mass" && name != "density" && name != "pressure")
+    if (name == "position" || name == "velocity" || name == "acceleration" || name == "acceleration_prev" ||
+        name == "mass" || name == "density" || name == "pressure")
+      continue;
+    try {
       particles.add_field(name, static_cast<int>(components));
+    } catch (const std::invalid_argument& e) {  // an existing field of another shape
+      throw detail::Malformed(fmt::format("field '{}': {}", name, e.what()));
+    }
   }
   auto views = particles.fields();
   for (const auto& [name, components] : fields) {

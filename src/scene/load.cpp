@@ -460,7 +460,7 @@ StellarSource read_stellar(const Table& t, const Scene& s, std::size_t kind) {
       if (src.count < 2) t.fail("count", "a collision needs at least 2 particles");
       c.mass_fraction = t.number("mass_fraction", 0.5, Range{0, 1, true, true});
       c.separation = t.number("separation", 10.0, kPositive);
-      c.impact_parameter = t.number("impact_parameter", 2.0, Range{0, c.separation, false, true});
+      c.impact_parameter = t.number("impact_parameter", std::min(2.0, 0.2 * c.separation), Range{0, c.separation, false, true});
       if (t.find("relative_velocity")) c.relative_velocity = t.number("relative_velocity", {}, kNonNegative);
       c.mass_cut = t.number("mass_cut", 0.999, cut);
       break;
