@@ -1,11 +1,13 @@
 # swirl: the two commands.
 #
 #   make demo   install what is missing (Debian packages), build, run the default scene
-#   make test   install what is missing, build, run every test with CTest
+#   make test   install what is missing, build, run every test with CTest, then the
+#               parallel tests under ThreadSanitizer and a fuzz smoke run (60 s per target)
 #
-# Other targets: build, asan-test (tests under AddressSanitizer+UBSan, long
-# tests skipped), tsan-test (the parallel tests under ThreadSanitizer), debug,
-# clean, deps.
+# Other targets: build, unit-test (CTest only), asan-test (tests under
+# AddressSanitizer+UBSan, long tests skipped), tsan-test (the parallel tests
+# under ThreadSanitizer), fuzz (libFuzzer smoke run; FUZZ_SECONDS=600 for
+# longer), debug, clean, deps.
 
 PRESET   ?= release
 JOBS     ?= $(shell nproc)
@@ -19,7 +21,7 @@ DEB_PACKAGES := cmake ninja-build g++ make git pkg-config \
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps configure build test demo asan-test tsan-test debug clean
+.PHONY: all deps configure build test unit-test demo asan-test tsan-test fuzz debug clean
 
 all: build
 
@@ -40,7 +42,9 @@ configure: deps
 build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
 
-test: build
+test: unit-test tsan-test fuzz
+
+unit-test: build
 	ctest --preset $(PRESET)
 
 demo: build
@@ -54,6 +58,9 @@ asan-test: deps
 
 tsan-test: deps
 	bash .ci/tsan.sh
+
+fuzz: deps
+	bash .ci/fuzz.sh
 
 debug: deps
 	cmake --preset debug

@@ -139,6 +139,7 @@ struct HashStatsArgs {
 // Table 5.2 of the thesis, beside this run's figures.
 int hash_stats(const HashStatsArgs& args) {
   const auto scene = swirl::scene::load_scene(args.scene, args.overrides);
+  swirl::sim::check_memory(scene);  // before the particles are built, as `swirl run` does
   if (args.threads > 0) swirl::parallel::set_thread_count(args.threads);
   const auto s = swirl::sim::scene_hash_statistics(scene, args.steps);
   fmt::print("hash-stats: {}: {} particles, h = {} m, {} mean neighbours{}\n", scene.file, s.particles,

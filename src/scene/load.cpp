@@ -461,6 +461,12 @@ StellarSource read_stellar(const Table& t, const Scene& s, std::size_t kind) {
       c.mass_fraction = t.number("mass_fraction", 0.5, Range{0, 1, true, true});
       c.separation = t.number("separation", 10.0, kPositive);
       c.impact_parameter = t.number("impact_parameter", std::min(2.0, 0.2 * c.separation), Range{0, c.separation, false, true});
+      // Each sphere needs a particle, and the geometry (d², the parabolic speed √(2/d)) must stay finite.
+      const double n1 = std::round(c.mass_fraction * static_cast<double>(src.count));
+      if (n1 < 1 || n1 > static_cast<double>(src.count) - 1)
+        t.fail("mass_fraction", fmt::format("{} of {} particles leaves one sphere empty", c.mass_fraction, src.count));
+      if (!std::isfinite(c.separation * c.separation) || !std::isfinite(std::sqrt(2.0 / c.separation)))
+        t.fail("separation", fmt::format("{} is out of the usable range", c.separation));
       if (t.find("relative_velocity")) c.relative_velocity = t.number("relative_velocity", {}, kNonNegative);
       c.mass_cut = t.number("mass_cut", 0.999, cut);
       break;
@@ -576,6 +582,11 @@ void read_random_box(const Table& top, Scene& s) {
   src.count = rb.particles;
   src.seed = rb.seed;
   src.mass = s.sph->rest_density * side * side * side / static_cast<double>(rb.particles);
+  // Extreme h, k or rest density can overflow or underflow the derived box and mass.
+  if (!(side > 0) || !std::isfinite(side) || !(src.mass > 0) || !std::isfinite(src.mass))
+    t.fail("neighbours", fmt::format("the random box derived from sph.smoothing_length = {}, sph.rest_density = {} "
+                                     "and neighbours = {} has side {} and particle mass {}: not usable",
+                                     h, s.sph->rest_density, rb.neighbors, side, src.mass));
   s.sources.emplace_back(src);
   s.random_box = rb;
 }

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <variant>
 
@@ -122,10 +123,31 @@ class Filler {
           model.velocity.get(n).template cast<double>() + s.velocity, double(model.mass[n]));
   }
 
+  std::size_t count() const { return next_; }
+
  private:
   ParticleSet<Real>& out_;
   std::size_t next_ = 0;
 };
+
+// Values finite in double can overflow the scene's precision (1e300 in float),
+// a mass underflow to 0, and a generator overflow on extreme sizes: refused
+// here, naming the source, instead of handing a solver inf or NaN.
+template <class Real>
+void check_finite(const Scene& scene, std::size_t source, const ParticleSet<Real>& p, std::size_t begin,
+                  std::size_t end) {
+  for (std::size_t i = begin; i < end; ++i) {
+    const Vec3<Real> x = p.position.get(i), v = p.velocity.get(i);
+    const Real m = p.mass[i];
+    if (std::isfinite(x.x) && std::isfinite(x.y) && std::isfinite(x.z) && std::isfinite(v.x) && std::isfinite(v.y) &&
+        std::isfinite(v.z) && std::isfinite(m) && m > 0)
+      continue;
+    throw SceneError(fmt::format("{}: particles[{}]: particle {} does not fit {} precision: position ({}, {}, {}), "
+                                 "velocity ({}, {}, {}), mass {}",
+                                 scene.file, source, i, sizeof(Real) == 4 ? "float" : "double", x.x, x.y, x.z, v.x,
+                                 v.y, v.z, m));
+  }
+}
 
 // A Scene built in code has not been through validation; these would otherwise
 // read out of bounds or allocate without limit.
@@ -163,7 +185,16 @@ ParticleSet<Real> make_particles(const Scene& scene) {
   check_buildable(scene, count);
   ParticleSet<Real> particles(static_cast<std::size_t>(count));
   Filler<Real> fill(particles);
-  for (const auto& source : scene.sources) std::visit(fill, source);
+  for (std::size_t k = 0; k < scene.sources.size(); ++k) {
+    const std::size_t begin = fill.count();
+    try {
+      std::visit(fill, scene.sources[k]);
+    } catch (const std::invalid_argument& e) {
+      // A model generator's precondition (gravity/initial_conditions.hpp) that validation missed.
+      throw SceneError(fmt::format("{}: particles[{}]: {}", scene.file, k, e.what()));
+    }
+    check_finite(scene, k, particles, begin, fill.count());
+  }
   return particles;
 }
 

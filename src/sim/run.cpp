@@ -316,14 +316,18 @@ std::uint64_t memory_available() {
 
 }  // namespace
 
-void check_resources(const scene::Scene& scene, const std::filesystem::path& out_dir) {
+void check_memory(const scene::Scene& scene) {
   const Footprint f = footprint(scene);
   const std::uint64_t available = memory_available();
   if (available > 0 && f.memory > 0.9 * static_cast<double>(available))
     throw std::invalid_argument(fmt::format(
         "{}: {} particles need about {:.1f} GB of memory, more than the {:.1f} GB this machine has free",
         scene.file, scene::count_particles(scene), f.memory / 1e9, static_cast<double>(available) / 1e9));
-  io::ensure_writable_directory(out_dir, static_cast<std::uintmax_t>(f.frame));
+}
+
+void check_resources(const scene::Scene& scene, const std::filesystem::path& out_dir) {
+  check_memory(scene);
+  io::ensure_writable_directory(out_dir, static_cast<std::uintmax_t>(footprint(scene).frame));
 }
 
 RunSummary run_scene(const scene::Scene& scene, const RunOptions& options,

@@ -1,6 +1,8 @@
 // One input of the scene fuzzer, through the real API: parse_scene() with an
 // optional override, then what `swirl run` does next with an accepted scene
-// (scene_hash, total_steps, and make_particles when the scene is small).
+// (scene_hash, total_steps, and make_particles when the scene is small), and
+// what `swirl run --resume` does: reload the effective scene it saved
+// (Scene::toml), which must give the same scene (the same scene_hash).
 //
 // Input format: the bytes are the scene's TOML text. If they start with
 // "#set ", the rest of that first line is also passed as one override
@@ -10,6 +12,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -53,8 +56,18 @@ inline std::optional<std::string> replay_scene(std::string_view bytes, bool stri
   const std::vector<std::string> overrides = scene_overrides(bytes);
   try {
     const scene::Scene s = scene::parse_scene(bytes, kSceneName, overrides);
-    (void)scene::scene_hash(s);
+    const std::uint64_t hash = scene::scene_hash(s);
     (void)s.total_steps();
+    // `swirl run --resume` reloads the effective scene from the scene.toml
+    // written from s.toml, and checks its hash against the checkpoint's.
+    try {
+      const scene::Scene again = scene::parse_scene(s.toml, kSceneName);
+      require(scene::scene_hash(again) == hash, "the effective scene (Scene::toml) loads as a different scene",
+              s.toml.substr(0, 2000));
+    } catch (const scene::SceneError& e) {
+      throw ContractViolation(std::string("the effective scene (Scene::toml) is refused: ") + e.what() + "\n" +
+                              s.toml.substr(0, 2000));
+    }
     const std::size_t n = scene::count_particles(s);
     require(n >= 1, "accepted scene without particles");
     if (n <= kBuildLimit) {

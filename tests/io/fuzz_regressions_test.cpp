@@ -1,13 +1,14 @@
-// Every input the VTK reader fuzzer ever crashed on (tests/fuzz/regressions/vtp/)
-// and every seed of its corpus (tests/fuzz/corpus/vtp/), replayed through
-// read_vtp and read_pvd exactly as tests/fuzz/vtp_fuzz.cpp does: each file is
-// read or refused with an IoError naming it; nothing else may escape.
+// Every input the io fuzzers ever crashed on (tests/fuzz/regressions/vtp/ and
+// .../checkpoint/) and every seed of their corpora (tests/fuzz/corpus/...),
+// replayed exactly as tests/fuzz/vtp_fuzz.cpp and checkpoint_fuzz.cpp do: each
+// file is read or refused with an IoError naming it; nothing else may escape.
 #include <gtest/gtest.h>
 
 #include <exception>
 #include <filesystem>
 #include <string>
 
+#include "fuzz/checkpoint_replay.hpp"
 #include "fuzz/io_replay.hpp"
 #include "fuzz/replay_files.hpp"
 
@@ -46,6 +47,43 @@ TEST(VtpFuzzRegressions, SeedsAreReadOrRefusedAsExpected) {
       EXPECT_FALSE(replay_pvd(file).has_value()) << name << ": " << replay_pvd(file).value_or("");
     }
   }
+}
+
+void replay_all_checkpoints(const std::filesystem::path& dir) {
+  for (const auto& file : input_files(dir)) {
+    SCOPED_TRACE(file.string());
+    try {
+      replay_checkpoint(file_bytes(file));
+      (void)replay_checkpoint_header(file);
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << file.filename().string() << ": " << e.what();
+    }
+  }
+}
+
+TEST(CheckpointFuzzRegressions, KeptCrashesAreReadOrRefusedWithIoError) {
+  replay_all_checkpoints(kFuzzDir / "regressions" / "checkpoint");
+}
+
+TEST(CheckpointFuzzRegressions, SeedCorpusIsReadOrRefusedWithIoError) {
+  EXPECT_FALSE(input_files(kFuzzDir / "corpus" / "checkpoint").empty());
+  replay_all_checkpoints(kFuzzDir / "corpus" / "checkpoint");
+}
+
+// The seeds swirl wrote are read in their own precision only; the truncated
+// one and the one claiming a future format version are refused.
+TEST(CheckpointFuzzRegressions, SeedsAreReadOrRefusedAsExpected) {
+  for (const auto& file : input_files(kFuzzDir / "corpus" / "checkpoint")) {
+    const std::string name = file.filename().string();
+    const std::string bytes = file_bytes(file);
+    const bool broken = name.starts_with("truncated") || name.starts_with("version");
+    const bool is_float = name.find("float") != std::string::npos;
+    EXPECT_EQ(replay_checkpoint_as<float>(bytes).has_value(), broken || !is_float) << name;
+    EXPECT_EQ(replay_checkpoint_as<double>(bytes).has_value(), broken || is_float) << name;
+  }
+  const auto refusal = replay_checkpoint_as<double>(file_bytes(kFuzzDir / "corpus" / "checkpoint" / "version2.ckp"));
+  ASSERT_TRUE(refusal.has_value());
+  EXPECT_NE(refusal->find("version 2"), std::string::npos) << *refusal;
 }
 
 }  // namespace

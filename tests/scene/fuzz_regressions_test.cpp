@@ -52,7 +52,7 @@ TEST(SceneFuzzRegressions, SeedsAreAcceptedOrRefusedAsNamed) {
 // Strict replay: an accepted scene must also make finite particles with
 // positive masses. Fails until absurd values (h = 1e300, a box beyond the
 // float range) are refused by validation; enable with that fix.
-TEST(SceneFuzzRegressions, DISABLED_StrictLimits) {
+TEST(SceneFuzzRegressions, StrictLimits) {
   replay_all(kFuzzDir / "regressions" / "scene", true);
   replay_all(kFuzzDir / "corpus" / "scene", true);
 }

@@ -82,6 +82,10 @@ struct RunSummary {
 // first outputs (io::IoError).
 void check_resources(const scene::Scene& scene, const std::filesystem::path& out_dir);
 
+// The memory half of check_resources, for commands that build the particles
+// without writing (swirl hash-stats).
+void check_memory(const scene::Scene& scene);
+
 // Runs the scene (after check_resources). Throws io::IoError before doing any work if out_dir cannot be
 // written (or, on resume, holds no valid checkpoint of this scene). A blow-up
 // or a write failure during the run stops it, keeps every frame and checkpoint
