@@ -106,6 +106,30 @@ TEST_F(Restart, SigintCheckpointsAndResumeMatchesTheUninterruptedRun) {
   expect_same_outputs(dir_ / "a", dir_ / "b");
 }
 
+// A second signal exits at once; whatever was written before stays readable.
+TEST_F(Restart, ASecondSignalExitsAtOnceLeavingWrittenFilesIntact) {
+  const std::string out = (dir_ / "b").string();
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const std::string cmd = std::string(SWIRL_CLI) + " run " + kGravity + " --steps 100000 --out " + out +
+                            " >/dev/null 2>" + (dir_ / "child.err").string();
+    execl("/bin/sh", "sh", "-c", ("exec " + cmd).c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  for (int k = 0; k < 2000 && !fs::exists(dir_ / "b" / "particles_000002.vtp"); ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  kill(child, SIGTERM);
+  kill(child, SIGTERM);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << slurp(dir_ / "child.err");
+  EXPECT_EQ(WEXITSTATUS(status), 143);
+  const auto frames = swirl::io::read_pvd(dir_ / "b" / "particles.pvd");
+  ASSERT_GE(frames.size(), 3u);
+  for (const auto& f : frames) EXPECT_EQ(swirl::io::read_vtp(dir_ / "b" / f.file).num_points, 400u) << f.file;
+}
+
 // The disk fills up mid-run (a 600 KB tmpfs, frames of ~176 KB): the run stops
 // with a message and exit status 1, and every frame written before is intact.
 TEST_F(Restart, AFullDiskMidRunKeepsTheEarlierFrames) {
