@@ -122,7 +122,7 @@ std::vector<std::filesystem::path> checkpoints_in(const std::filesystem::path& o
 }
 
 template <class Real>
-RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
+RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::uintmax_t first_output_bytes,
                      const std::function<void(const RunProgress&)>& on_progress) {
   RunSummary summary;
   summary.scene_file = scene.file;
@@ -132,6 +132,9 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options,
   const std::uint64_t hash = scene::scene_hash(scene);
 
   auto built = build_simulation<Real>(scene);
+  // Only now, so that a scene refused while its particles are built leaves no
+  // empty output directory behind; nothing has been run yet.
+  io::ensure_writable_directory(options.out_dir, first_output_bytes);
   Simulation<Real>& sim = built.sim;
   const sph::SphFluid<Real>* fluid = built.fluid;
   const gravity::GravityForce<Real>* self_gravity = built.self_gravity;
@@ -325,17 +328,13 @@ void check_memory(const scene::Scene& scene) {
         scene.file, scene::count_particles(scene), f.memory / 1e9, static_cast<double>(available) / 1e9));
 }
 
-void check_resources(const scene::Scene& scene, const std::filesystem::path& out_dir) {
-  check_memory(scene);
-  io::ensure_writable_directory(out_dir, static_cast<std::uintmax_t>(footprint(scene).frame));
-}
-
 RunSummary run_scene(const scene::Scene& scene, const RunOptions& options,
                      const std::function<void(const RunProgress&)>& on_progress) {
-  check_resources(scene, options.out_dir);
+  check_memory(scene);
   if (options.threads > 0) parallel::set_thread_count(options.threads);
-  return scene.precision == scene::Precision::Float ? run_typed<float>(scene, options, on_progress)
-                                                    : run_typed<double>(scene, options, on_progress);
+  const auto frame = static_cast<std::uintmax_t>(footprint(scene).frame);
+  return scene.precision == scene::Precision::Float ? run_typed<float>(scene, options, frame, on_progress)
+                                                    : run_typed<double>(scene, options, frame, on_progress);
 }
 
 }  // namespace swirl::sim

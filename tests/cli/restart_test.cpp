@@ -180,6 +180,12 @@ TEST_F(Restart, ScenesBeyondMemoryOrSenseAreRefusedUpFront) {
   r = swirl("run " + kExamples + "falling_block.toml --set box.restitution=nan --out " + (dir_ / "h").string());
   EXPECT_NE(r.err.find("box.restitution: must be finite, got nan"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_ / "h"));
+  // Refused while its particles are built (a mass that overflows float): no output directory either.
+  r = swirl("run " + std::string(SWIRL_SOURCE_DIR) + "/tests/fuzz/corpus/scene/limit_float_mass_1e300.toml --out " +
+            (dir_ / "p").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("does not fit float precision"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "p"));
 }
 
 }  // namespace

@@ -76,18 +76,13 @@ struct RunSummary {
   std::vector<std::string> warnings;    // e.g. a corrupt checkpoint skipped on resume
 };
 
-// Refuses, before anything is allocated or run, a scene whose particles would
-// not fit in the free memory (std::invalid_argument with the estimate and the
-// limit) or an output directory that cannot be written or has no room for the
-// first outputs (io::IoError).
-void check_resources(const scene::Scene& scene, const std::filesystem::path& out_dir);
-
-// The memory half of check_resources, for commands that build the particles
-// without writing (swirl hash-stats).
+// Refuses, before anything is allocated, a scene whose particles would not fit
+// in the free memory (std::invalid_argument with the estimate and the limit).
 void check_memory(const scene::Scene& scene);
 
-// Runs the scene (after check_resources). Throws io::IoError before doing any work if out_dir cannot be
-// written (or, on resume, holds no valid checkpoint of this scene). A blow-up
+// Runs the scene. Before running anything it calls check_memory(), builds the
+// particles, and throws io::IoError if out_dir cannot be written, has no room
+// for the first outputs, or (on resume) holds no valid checkpoint of this scene. A blow-up
 // or a write failure during the run stops it, keeps every frame and checkpoint
 // already written, and is reported in RunSummary::error. The effective scene is
 // saved as out_dir/scene.toml.
