@@ -4,12 +4,14 @@
 //   swirl bench gravity  seconds for 50 Barnes–Hut iterations (the paper's Table 2)
 #include <chrono>
 #include <map>
+#include <memory>
 #include <string>
 #include <utility>
 
 #include <fmt/format.h>
 
 #include "bench.hpp"
+#include "commands.hpp"
 #include "swirl/gravity/bench.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
@@ -62,7 +64,7 @@ std::string thesis_sph(std::size_t n, double k) {
 
 }  // namespace
 
-int bench_sph(const BenchArgs& args) {
+int bench_sph_table(const BenchArgs& args) {
   fmt::print("swirl bench sph: the thesis's random box (dt = 0.003 s, h = 0.05 m), {} warm-up + {} timed steps\n",
              args.warmup, args.steps);
   fmt::print("{:>8} {:>11} {:>8} {:>10} {:>12} {:>10}   {}\n", "N", "neighbours", "threads", "steps/s", "measured k",
@@ -93,7 +95,7 @@ int bench_sph(const BenchArgs& args) {
   return 0;
 }
 
-int bench_gravity(const BenchArgs& args) {
+int bench_gravity_table(const BenchArgs& args) {
   fmt::print("swirl bench gravity: Plummer sphere, lambda = {}, {} iterations, double; seconds (paper: Table 2, -O3)\n",
              args.opening, args.iterations);
   fmt::print("{:>8} {:>8} {:>10} {:>10} {:>10} {:>10} {:>11}   {}\n", "N", "threads", "scheme", "total", "tree",
@@ -118,6 +120,26 @@ int bench_gravity(const BenchArgs& args) {
     }
   }
   return 0;
+}
+
+void add_bench_commands(CLI::App& app, Commands& commands) {
+  auto bench = std::make_shared<BenchArgs>();
+  auto* bench_cmd = app.add_subcommand("bench", "Measure the seeds' performance tables on this machine");
+  bench_cmd->require_subcommand(1);
+  auto* bench_sph = bench_cmd->add_subcommand("sph", "Steps per second of the thesis's random box (Tables 5.1, 5.3)");
+  bench_sph->add_option("--particles", bench->particles, "Particle counts")->delimiter(',');
+  bench_sph->add_option("--neighbours", bench->neighbours, "Target neighbour counts")->delimiter(',');
+  bench_sph->add_option("--threads", bench->threads, "Thread counts")->delimiter(',');
+  bench_sph->add_option("--steps", bench->steps, "Timed steps")->check(CLI::PositiveNumber);
+  bench_sph->add_option("--warmup", bench->warmup, "Steps before timing")->check(CLI::NonNegativeNumber);
+  commands.push_back({bench_sph, [bench] { return bench_sph_table(*bench); }});
+  auto* bench_grav = bench_cmd->add_subcommand("gravity", "Seconds for Barnes-Hut iterations (the paper's Table 2)");
+  bench_grav->add_option("--particles", bench->gravity_particles, "Particle counts")->delimiter(',');
+  bench_grav->add_option("--threads", bench->threads, "Thread counts")->delimiter(',');
+  bench_grav->add_option("--schemes", bench->schemes, "subdomain,subtree,global")->delimiter(',');
+  bench_grav->add_option("--iterations", bench->iterations, "Iterations")->check(CLI::PositiveNumber);
+  bench_grav->add_option("--opening", bench->opening, "Opening criterion lambda")->check(CLI::Range(0.0, 1.0));
+  commands.push_back({bench_grav, [bench] { return bench_gravity_table(*bench); }});
 }
 
 }  // namespace swirl::cli

@@ -19,7 +19,7 @@ struct BenchArgs {
   double opening = 0.5;
 };
 
-int bench_sph(const BenchArgs& args);
-int bench_gravity(const BenchArgs& args);
+int bench_sph_table(const BenchArgs& args);
+int bench_gravity_table(const BenchArgs& args);
 
 }  // namespace swirl::cli

@@ -44,17 +44,24 @@ class FrameWriter {
     series_.set_entries(std::move(entries));
   }
 
-  void write(const ParticleSet<Real>& p, double time) {
+  // Writes frame number frames() and returns its first file.
+  std::filesystem::path write(const ParticleSet<Real>& p, double time) {
+    std::filesystem::path first;
     for (auto format : scene_.formats) {
+      std::filesystem::path file;
       if (format == scene::OutputFormat::Vtp) {
         const std::string name = fmt::format("particles_{:06d}.vtp", frames_);
-        io::write_vtp(dir_ / name, p, time);
+        file = dir_ / name;
+        io::write_vtp(file, p, time);
         series_.add(time, name);
       } else {
-        io::write_csv(dir_ / fmt::format("particles_{:06d}.csv", frames_), p, time);
+        file = dir_ / fmt::format("particles_{:06d}.csv", frames_);
+        io::write_csv(file, p, time);
       }
+      if (first.empty()) first = file;
     }
     ++frames_;
+    return first;
   }
   std::size_t frames() const { return frames_; }
 
@@ -199,8 +206,9 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(); };
   auto write_frame = [&] {
     ScopedPhase phase(sim.timers(), "output");
-    writer.write(sim.particles(), sim.time());
+    const auto frame_file = writer.write(sim.particles(), sim.time());
     last_frame_step = sim.step_count();
+    if (options.on_frame) options.on_frame(frame_file, sim.time());
     if (fluid) {
       const auto d = sph::fluid_diagnostics(sim.particles(), scene.gravity, scene.sph->rest_density, scene.block_size);
       diagnostics->add({sim.time(), d.kinetic_energy, d.potential_energy, d.momentum.x, d.momentum.y, d.momentum.z,

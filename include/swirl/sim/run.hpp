@@ -44,6 +44,11 @@ struct RunOptions {
   // When set (by a signal handler), the run stops after the current step,
   // writes a checkpoint and returns with RunSummary::interrupted.
   const std::atomic<bool>* stop = nullptr;
+
+  // Called after each frame has been written, with the frame's file and its
+  // simulated time (e.g. to render it while the run goes on). An exception
+  // thrown here stops the run like a write failure.
+  std::function<void(const std::filesystem::path& frame, double time)> on_frame;
 };
 
 // Reported after start() and after every step.

@@ -1,0 +1,123 @@
+// `swirl run`: runs a scene (or resumes a run) and prints the closing summary.
+//
+//   swirl run SCENE [--threads N] [--out DIR] [--steps N | --until T] [--set key=value]... [--summary-json FILE]
+//             [--checkpoint-every T] [--checkpoint-every-steps N] [--checkpoint-keep K]
+//   swirl run --resume RUN_DIR [--steps N | --until T] [--threads N] [checkpoint options]
+#include <unistd.h>
+
+#include <atomic>
+#include <csignal>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "cli.hpp"
+#include "commands.hpp"
+#include "swirl/io/atomic_file.hpp"
+#include "swirl/scene/load.hpp"
+#include "swirl/sim/run.hpp"
+
+namespace swirl::cli {
+namespace {
+
+struct RunArgs {
+  std::string scene;
+  int threads = 0;
+  std::string out;
+  std::uint64_t steps = 0;
+  double until = 0;
+  std::vector<std::string> overrides;
+  std::string summary_json;
+  double checkpoint_every = 0;
+  std::uint64_t checkpoint_every_steps = 0;
+  std::size_t checkpoint_keep = 2;
+  std::string resume;
+};
+
+// SIGINT/SIGTERM: the first asks the run to stop after the current step (it
+// then writes a checkpoint); a second one exits at once. Every file is written
+// atomically, so exiting mid-write leaves only a stray temporary file.
+std::atomic<bool> g_stop{false};
+std::atomic<int> g_signal{0};
+extern "C" void on_signal(int sig) {
+  if (g_stop.exchange(true)) _exit(128 + sig);
+  g_signal.store(sig);
+}
+
+int run(const RunArgs& args) {
+  sim::RunOptions options;
+  scene::Scene scene;
+  if (!args.resume.empty()) {
+    if (!args.scene.empty() || !args.overrides.empty())
+      throw std::invalid_argument("--resume continues the scene saved in RUN_DIR; give no SCENE or --set");
+    options.out_dir = args.resume;
+    options.resume = true;
+    scene = scene::load_scene(options.out_dir / "scene.toml");
+  } else {
+    if (args.scene.empty()) throw std::invalid_argument("give a SCENE file, or --resume RUN_DIR");
+    scene = scene::load_scene(args.scene, args.overrides);
+    options.out_dir = args.out.empty() ? std::filesystem::path("out") / std::filesystem::path(args.scene).stem()
+                                       : std::filesystem::path(args.out);
+  }
+  options.threads = args.threads;
+  if (args.steps > 0) options.steps = args.steps;
+  if (args.until > 0) options.until = args.until;
+  if (args.checkpoint_every > 0) options.checkpoint_every = args.checkpoint_every;
+  if (args.checkpoint_every_steps > 0) options.checkpoint_every_steps = args.checkpoint_every_steps;
+  options.checkpoint_keep = args.checkpoint_keep;
+  options.stop = &g_stop;
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  ProgressDisplay progress(stderr);
+  const auto summary = sim::run_scene(scene, options, [&](const auto& p) { progress.update(p); });
+  progress.finish();
+  for (const auto& w : summary.warnings) fmt::print(stderr, "swirl run: warning: {}\n", w);
+
+  fmt::print("{}\n{}",
+             summary.interrupted ? "swirl run: INTERRUPTED" : (summary.error.empty() ? "swirl run: done" : "swirl run: STOPPED"),
+             summary_text(summary));
+  if (!args.summary_json.empty()) io::write_file_atomic(args.summary_json, summary_json(summary));
+  if (summary.interrupted) {
+    fmt::print(stderr, "swirl run: interrupted at t = {:.6g} (checkpoint {}); resume with: swirl run --resume {}\n",
+               summary.sim_time, summary.last_checkpoint.string(), options.out_dir.string());
+    return 128 + g_signal.load();
+  }
+  if (!summary.error.empty()) {
+    fmt::print(stderr, "swirl run: {}\nswirl run: frames written before the failure are intact in {}\n", summary.error,
+               options.out_dir.string());
+    return 1;
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_run_command(CLI::App& app, Commands& commands) {
+  auto args = std::make_shared<RunArgs>();
+  auto* run_cmd = app.add_subcommand("run", "Run a scene file and write its frames");
+  run_cmd->add_option("scene", args->scene, "Scene file (TOML)");
+  run_cmd->add_option("--threads,-t", args->threads, "Threads (default: all cores, or OMP_NUM_THREADS)")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--out,-o", args->out, "Output directory (default: out/<scene name>)");
+  auto* steps_opt = run_cmd->add_option("--steps", args->steps, "Number of steps to take, replacing the scene's end time")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--until", args->until, "Run until this simulated time")->check(CLI::PositiveNumber)->excludes(steps_opt);
+  run_cmd->add_option("--checkpoint-every", args->checkpoint_every, "Write a checkpoint every T of simulated time")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--checkpoint-every-steps", args->checkpoint_every_steps, "Write a checkpoint every N steps")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--checkpoint-keep", args->checkpoint_keep, "Checkpoints to keep (default 2)")
+      ->check(CLI::PositiveNumber);
+  run_cmd->add_option("--resume", args->resume, "Continue the run in RUN_DIR from its newest valid checkpoint")
+      ->type_name("RUN_DIR");
+  run_cmd->add_option("--set", args->overrides, "Override a scene key, e.g. --set box.restitution=0.9")
+      ->type_name("KEY=VALUE");
+  run_cmd->add_option("--summary-json", args->summary_json, "Also write the closing summary as JSON to FILE");
+  commands.push_back({run_cmd, [args] { return run(*args); }});
+}
+
+}  // namespace swirl::cli
