@@ -20,15 +20,23 @@ enum class NegativePressure {
   Zero,  // p = max(0, c² (ρ − ρ0)): no tension, so free surfaces do not clump
 };
 
+// How neighbours are found (sph_fluid.hpp).
+enum class NeighbourSearch {
+  Grid,  // sorted cell grid, particles reordered in memory, passes on the fly (spatial/cell_grid.hpp)
+  Hash,  // the thesis's spatial hash with CSR interaction lists (spatial/spatial_hash.hpp)
+};
+
 struct SphParameters {
   double smoothing_length = 0;     // h, m (> 0): kernel support and hash cell length
   double rest_density = 1000;      // ρ0, kg/m³
   double sound_speed = 10;         // c, m/s
   double viscosity = 0.1;          // μ, Pa·s (≥ 0)
-  std::uint32_t buckets = 0;       // hash table size M; 0 = the thesis's ≈ 1.6·N (made odd)
-  bool duplicate_check = true;     // the cell-relation check of section 4.2.3
+  std::uint32_t buckets = 0;       // hash: table size M; 0 = the thesis's ≈ 1.6·N (made odd)
+  bool duplicate_check = true;     // hash: the cell-relation check of section 4.2.3
   PressureForm pressure_form = PressureForm::Thesis;
   NegativePressure negative_pressure = NegativePressure::Keep;
+  NeighbourSearch neighbour_search = NeighbourSearch::Grid;
+  bool simd = true;                // grid: explicit SIMD passes (false: their scalar twin)
 };
 
 // The thesis's table size for n particles: 1.6·n, odd (24001 for 15000).

@@ -1,6 +1,17 @@
 // SphFluid<Real>: the thesis's SPH fluid as a force model (sections 2.1 and 4).
 //
-// Each force evaluation:
+// Two neighbour searches (SphParameters::neighbour_search), the same physics:
+//  - Grid (the default): the particles are sorted by cell and EVERY field is
+//    moved into that order (ids travel along, so storage order changes from
+//    step to step; use id to follow a particle)                  ("forces.sort")
+//    then density and pressure, then the forces, each computed on the fly over
+//    the 27 cells (9 contiguous ranges) around each particle, with explicit
+//    SIMD (sph/grid_passes.hpp)                  ("forces.density", "forces.sph")
+//    Particles spread over more than 2^21 cells in an axis fall back to the hash
+//    for that evaluation.
+//  - Hash: the thesis's path, unchanged:
+//
+// Each force evaluation of the hash path:
 //  1. builds the spatial hash of the positions                  ("forces.hash")
 //  2. finds every particle's neighbours (r < h) into interaction lists and,
 //     as soon as a particle's list is complete, its density and pressure
@@ -45,8 +56,11 @@
 #include "swirl/core/phase_timers.hpp"
 #include "swirl/force/force_model.hpp"
 #include "swirl/parallel/for_blocks.hpp"
+#include "swirl/sph/grid_passes.hpp"
 #include "swirl/sph/kernels.hpp"
 #include "swirl/sph/parameters.hpp"
+#include "swirl/spatial/cell_grid.hpp"
+#include "swirl/spatial/reorder_particles.hpp"
 #include "swirl/spatial/spatial_hash.hpp"
 
 namespace swirl::sph {
@@ -65,6 +79,72 @@ class SphFluid final : public ForceModel<Real> {
   std::string_view name() const override { return "sph"; }
 
   void add_acceleration(ParticleSet<Real>& p, const ForceContext& ctx) override {
+    if (params_.neighbour_search == NeighbourSearch::Grid && add_acceleration_grid(p, ctx)) return;
+    add_acceleration_hash(p, ctx);
+  }
+
+  // Interaction lists of the last evaluation (one row per particle; hash search
+  // only: the grid computes on the fly and leaves them empty).
+  const spatial::NeighborList<Real>& lists() const { return lists_; }
+  // Mean neighbours per particle in the last evaluation (self excluded).
+  double mean_neighbors() const { return mean_neighbors_; }
+  const spatial::SpatialHash<Real>& hash() const { return hash_; }
+  const spatial::SortedCellGrid<Real>& grid() const { return grid_; }
+  const SphParameters& parameters() const { return params_; }
+  // True when the last evaluation used the sorted grid (and reordered the particles).
+  bool used_grid() const { return used_grid_; }
+  // Bytes the solver keeps between evaluations (search structures, lists,
+  // reorder scratch), in all: add to the particle fields for the memory per particle.
+  std::size_t scratch_bytes() const {
+    return grid_.bytes() + reorder_.bytes() + scratch_.bytes() +
+           lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
+           lists_.neighbor.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
+           hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
+           hash_.offsets().capacity() * sizeof(std::uint32_t) + hash_.order().capacity() * sizeof(std::uint32_t);
+  }
+
+ private:
+  // The sorted grid (spatial/cell_grid.hpp, sph/grid_passes.hpp): sort by
+  // cell, reorder every field, then density and forces on the fly. Returns
+  // false, having done nothing, when the particles spread too far for the grid.
+  bool add_acceleration_grid(ParticleSet<Real>& p, const ForceContext& ctx) {
+    {
+      PhaseScope phase(ctx, "forces.sort");
+      if (!grid_.sort(p, params_.smoothing_length, ctx.block_size)) return false;
+      reorder_.apply(p, grid_.order(), ctx.block_size);
+      grid_.index(ctx.block_size);
+    }
+    used_grid_ = true;
+    lists_ = {};
+    GridPassConstants<Real> k;
+    k.h = Real(params_.smoothing_length);
+    k.h2 = k.h * k.h;
+    k.rest_density = Real(params_.rest_density);
+    k.c2 = Real(params_.sound_speed * params_.sound_speed);
+    k.pressure_floor = params_.negative_pressure == NegativePressure::Zero ? Real(0)
+                                                                            : -std::numeric_limits<Real>::infinity();
+    k.mu = Real(params_.viscosity);
+    k.half = params_.pressure_form == PressureForm::Thesis ? Real(0.5) : Real(1);
+    std::uint64_t pairs = 0;
+    {
+      PhaseScope phase(ctx, "forces.density");
+      pairs = params_.simd ? grid_density<Real, true>(grid_, p, k, ctx.block_size, scratch_)
+                           : grid_density<Real, false>(grid_, p, k, ctx.block_size, scratch_);
+    }
+    mean_neighbors_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
+    {
+      PhaseScope phase(ctx, "forces.sph");
+      if (params_.simd)
+        grid_forces<Real, true>(grid_, p, k, ctx.block_size, scratch_);
+      else
+        grid_forces<Real, false>(grid_, p, k, ctx.block_size, scratch_);
+    }
+    return true;
+  }
+
+  // The thesis's path: spatial hash, lists with density inside the search.
+  void add_acceleration_hash(ParticleSet<Real>& p, const ForceContext& ctx) {
+    used_grid_ = false;
     const std::size_t n = p.size();
     const Real h = Real(params_.smoothing_length);
     {
@@ -93,18 +173,9 @@ class SphFluid final : public ForceModel<Real> {
       PhaseScope phase(ctx, "forces.sph");
       add_pair_forces(p, ctx.block_size);
     }
+    mean_neighbors_ = lists_.rows() ? static_cast<double>(lists_.interactions()) / static_cast<double>(lists_.rows()) : 0.0;
   }
 
-  // Interaction lists of the last evaluation (one row per particle).
-  const spatial::NeighborList<Real>& lists() const { return lists_; }
-  // Mean neighbours per particle in the last evaluation (self excluded).
-  double mean_neighbors() const {
-    return lists_.rows() ? static_cast<double>(lists_.interactions()) / static_cast<double>(lists_.rows()) : 0.0;
-  }
-  const spatial::SpatialHash<Real>& hash() const { return hash_; }
-  const SphParameters& parameters() const { return params_; }
-
- private:
   // Times a sub-phase when the caller keeps timers.
   struct PhaseScope {
     PhaseScope(const ForceContext& ctx, std::string_view name) {
@@ -149,6 +220,11 @@ class SphFluid final : public ForceModel<Real> {
   SphParameters params_;
   spatial::SpatialHash<Real> hash_;
   spatial::NeighborList<Real> lists_;
+  spatial::SortedCellGrid<Real> grid_;
+  spatial::ParticleReorder<Real> reorder_;
+  GridScratch<Real> scratch_;
+  double mean_neighbors_ = 0;
+  bool used_grid_ = false;
 };
 
 }  // namespace swirl::sph
