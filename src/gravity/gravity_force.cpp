@@ -19,7 +19,10 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const ForceConte
     stats_.mean_nodes_visited = p.empty() ? 0.0 : double(p.size() - 1);
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   } else {
-    tree_.compute(p, field_, ctx.block_size);
+    if (settings_.reorder)
+      tree_.compute_reordering(p, field_, ctx.block_size);  // reorders p with the linear tree
+    else
+      tree_.compute(p, field_, ctx.block_size);
     stats_ = tree_.stats();
   }
   const std::size_t phi_field = p.add_field("potential", 1);

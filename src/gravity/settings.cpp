@@ -14,6 +14,11 @@ constexpr std::array<std::pair<std::string_view, Method>, 2> kMethods{{
     {"direct", Method::direct}, {"barnes_hut", Method::barnes_hut}}};
 constexpr std::array<std::pair<std::string_view, Scheme>, 3> kSchemes{{
     {"subdomain", Scheme::subdomain}, {"subtree", Scheme::subtree}, {"global", Scheme::global}}};
+constexpr std::array<std::pair<std::string_view, Tree>, 2> kTrees{{{"paper", Tree::paper}, {"linear", Tree::linear}}};
+constexpr std::array<std::pair<std::string_view, Multipole>, 2> kMultipoles{{
+    {"monopole", Multipole::monopole}, {"quadrupole", Multipole::quadrupole}}};
+constexpr std::array<std::pair<std::string_view, Criterion>, 2> kCriteria{{
+    {"paper", Criterion::paper}, {"barnes", Criterion::barnes}}};
 
 template <class Enum, std::size_t N>
 Enum parse(std::string_view what, std::string_view name, const std::array<std::pair<std::string_view, Enum>, N>& table) {
@@ -35,6 +40,12 @@ std::string_view name_of(Enum value, const std::array<std::pair<std::string_view
 
 std::string_view to_string(Method method) { return name_of(method, kMethods); }
 std::string_view to_string(Scheme scheme) { return name_of(scheme, kSchemes); }
+std::string_view to_string(Tree tree) { return name_of(tree, kTrees); }
+std::string_view to_string(Multipole multipole) { return name_of(multipole, kMultipoles); }
+std::string_view to_string(Criterion criterion) { return name_of(criterion, kCriteria); }
+Tree parse_tree(std::string_view name) { return parse("tree", name, kTrees); }
+Multipole parse_multipole(std::string_view name) { return parse("multipole", name, kMultipoles); }
+Criterion parse_criterion(std::string_view name) { return parse("opening criterion", name, kCriteria); }
 Method parse_method(std::string_view name) { return parse("method", name, kMethods); }
 Scheme parse_scheme(std::string_view name) { return parse("scheme", name, kSchemes); }
 
@@ -47,6 +58,7 @@ void validate(const GravitySettings& s) {
     throw std::invalid_argument(fmt::format("gravity softening epsilon = {} must be finite and >= 0", s.softening));
   if (s.subdomain_size < 1) throw std::invalid_argument("gravity subdomain_size must be at least 1 particle");
   if (s.subtree_nodes < 1) throw std::invalid_argument("gravity subtree_nodes must be at least 1 node");
+  if (s.bucket_size < 1) throw std::invalid_argument("gravity bucket_size must be at least 1 particle");
 }
 
 }  // namespace swirl::gravity

@@ -62,6 +62,24 @@ TYPED_TEST(ParametersTest, ZeroSizes) {
   s = {};
   s.subtree_nodes = 0;
   expect_invalid([&] { GravityForce<Real> g(s); }, {"subtree_nodes"});
+  s = {};
+  s.bucket_size = 0;
+  expect_invalid([&] { GravityForce<Real> g(s); }, {"bucket_size"});
+}
+
+TEST(ParametersTest, TreeMultipoleAndCriterionNamesRoundTrip) {
+  for (Tree t : {Tree::paper, Tree::linear}) EXPECT_EQ(parse_tree(to_string(t)), t);
+  for (Multipole m : {Multipole::monopole, Multipole::quadrupole}) EXPECT_EQ(parse_multipole(to_string(m)), m);
+  for (Criterion c : {Criterion::paper, Criterion::barnes}) EXPECT_EQ(parse_criterion(to_string(c)), c);
+  expect_invalid([] { (void)parse_tree("kd"); }, {"tree", "kd", "\"paper\"", "\"linear\""});
+  expect_invalid([] { (void)parse_multipole("octupole"); }, {"octupole", "\"monopole\"", "\"quadrupole\""});
+  expect_invalid([] { (void)parse_criterion("bmax"); }, {"bmax", "\"paper\"", "\"barnes\""});
+  // The defaults of the issue: the linear tree, quadrupoles, Barnes' rule.
+  const GravitySettings s;
+  EXPECT_EQ(s.scheme, Scheme::global);
+  EXPECT_EQ(s.tree, Tree::linear);
+  EXPECT_EQ(s.multipole, Multipole::quadrupole);
+  EXPECT_EQ(s.criterion, Criterion::barnes);
 }
 
 TEST(ParametersTest, UnknownSchemeOrMethodListsTheAllowedNames) {

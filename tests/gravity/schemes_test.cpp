@@ -28,6 +28,7 @@ TYPED_TEST_SUITE(SchemesTest, testing::Precisions);
 GravitySettings settings(Scheme scheme, double lambda, double eps, bool small) {
   GravitySettings s;
   s.scheme = scheme;
+  s.tree = Tree::paper;  // the paper's schemes and tree; the linear tree: linear_tree_test.cpp
   s.opening = lambda;
   s.softening = eps;
   if (small) {

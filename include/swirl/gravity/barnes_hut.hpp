@@ -2,7 +2,9 @@
 // al. 2011, sections 2 and 4), computing a GravityField for a ParticleSet.
 //
 // Which trees a particle walks (the approximation) is the paper's:
-//   global     one tree of all particles, walked from the root.
+//   global     one tree of all particles, walked from the root: the linear
+//              octree (linear_octree.hpp, the default: settings.tree) or the
+//              paper's insertion-built tree.
 //   subdomain  (4.1) particles sorted in Morton order of their positions in the
 //              bounding cube, cut into runs of ≤ subdomain_size particles by
 //              packing Morton cells greedily (the paper's 512 cells, grown
@@ -38,6 +40,7 @@
 
 #include "swirl/core/particle_set.hpp"
 #include "swirl/gravity/field.hpp"
+#include "swirl/gravity/linear_octree.hpp"
 #include "swirl/gravity/octree.hpp"
 #include "swirl/gravity/settings.hpp"
 
@@ -51,6 +54,10 @@ struct GravityStats {
   int depth = 0;                  // deepest tree level
   double tree_build_seconds = 0;  // sorting, tree construction, cutting into units
   double force_seconds = 0;       // walks and the per-particle sums
+  // Linear tree only (0 otherwise):
+  double mean_interactions = 0;   // node expansions + particle pairs evaluated per particle
+  std::size_t tree_bytes = 0;     // memory the tree holds (nodes, sorted copies, keys, sort buffers)
+  std::size_t leaves = 0;
 };
 
 template <class Real>
@@ -62,6 +69,15 @@ class BarnesHut {
   // Overwrites out (resized to p.size()) with the tree field of p. block_size
   // is the block of the per-particle passes (results do not depend on it).
   void compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  // The same, and with the linear tree also reorders p along the Morton curve
+  // (ParticleSet::reorder: every field moves, ids survive) before the walk;
+  // out is indexed like the reordered p.
+  void compute_reordering(ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+
+  // True when compute() walks the linear octree (scheme global, tree linear).
+  bool uses_linear_tree() const { return settings_.scheme == Scheme::global && settings_.tree == Tree::linear; }
+  // The linear octree of the last evaluation (empty unless uses_linear_tree()).
+  const LinearOctree<Real>& linear_tree() const { return linear_; }
 
   const GravitySettings& settings() const { return settings_; }
   const GravityStats& stats() const { return stats_; }
@@ -76,6 +92,10 @@ class BarnesHut {
     std::uint32_t entries_begin, entries_end;  // into entries_
   };
 
+  void compute_impl(const ParticleSet<Real>& p, ParticleSet<Real>* reorder, GravityField<Real>& out,
+                    std::size_t block_size);
+  void compute_linear(const ParticleSet<Real>& p, ParticleSet<Real>* reorder, GravityField<Real>& out,
+                      std::size_t block_size);
   void build_subdomains(const ParticleSet<Real>& p);
   void build_global_tree(const ParticleSet<Real>& p);
   void cut_units();
@@ -96,6 +116,8 @@ class BarnesHut {
   std::vector<GravityField<Real>> buffers_;  // one tree's contribution per buffer
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keys_;
   std::vector<std::uint32_t> identity_;
+  LinearOctree<Real> linear_;
+  std::vector<std::size_t> permutation_;
 };
 
 extern template class BarnesHut<float>;

@@ -1,11 +1,14 @@
 // Timing the paper's experiment (section 5): a Plummer sphere of N particles,
 // `iterations` steps of force evaluation + leapfrog update, per phase: the
 // rows of the paper's Table 1 (tree construction, force calculation, update
-// positions) and the totals of its Table 2.
+// positions) and the totals of its Table 2; and the accuracy side of its
+// Figures 14-15: the force error of the tree against the direct sum for a
+// given opening criterion λ.
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "swirl/gravity/settings.hpp"
 
@@ -49,5 +52,31 @@ inline BenchResult time_iterations(Scheme scheme, std::size_t n, double opening,
   s.threads = threads;
   return time_iterations(s);
 }
+
+// One tree configuration whose force error force_errors() measures.
+struct ForceErrorCase {
+  Scheme scheme = Scheme::global;
+  double opening = 0.5;  // λ
+};
+
+// Relative force error e_i = |a_tree,i − a_direct,i| / |a_direct,i| over all
+// particles (dimensionless), and the walk's cost.
+struct ForceError {
+  double median = 0;              // lower median of e_i
+  double p99 = 0;                 // 99th percentile of e_i (nearest rank)
+  double max = 0;                 // largest e_i
+  double mean_nodes_visited = 0;  // per particle, this evaluation
+};
+
+// The error of one tree evaluation of `settings`' initial Plummer sphere (its
+// n, seed, softening, precision and threads; iterations ignored) for each
+// case, against the direct sum in double computed once for all cases. The
+// differences are taken in double. Restores the thread count. Throws
+// std::invalid_argument for bad settings or cases.
+std::vector<ForceError> force_errors(const BenchSettings& settings, const std::vector<ForceErrorCase>& cases);
+
+// The median, 99th percentile (nearest rank) and maximum of `errors`, which it
+// sorts; all zero for an empty vector. Shared with the tests' slow twin.
+ForceError summarize_errors(std::vector<double>& errors);
 
 }  // namespace swirl::gravity

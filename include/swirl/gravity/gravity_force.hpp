@@ -9,6 +9,10 @@
 // sub-domain load balance (the previous evaluation's work per tree) and the
 // last evaluation's statistics.
 //
+// With the linear tree and settings.reorder (the default), each call first
+// reorders the particles along the Morton curve (ParticleSet::reorder: every
+// field moves, ids survive), so the index of a particle changes between calls.
+//
 // Results are bit-identical for any thread count.
 #pragma once
 

@@ -4,7 +4,13 @@
 // E = −1/4). Lengths (ε) are in the same unit as positions.
 //
 // Invariants (validate() enforces them, with std::invalid_argument naming the
-// parameter and its allowed range): 0 ≤ λ ≤ 1, ε ≥ 0 and finite, both sizes ≥ 1.
+// parameter and its allowed range): 0 ≤ λ (θ) ≤ 1, ε ≥ 0 and finite, every size ≥ 1.
+//
+// Which tree: the scheme `global` walks `tree` (the linear octree by default,
+// or the paper's insertion-built tree); `subdomain` and `subtree` are the
+// paper's and always use the paper's tree. multipole, criterion and
+// bucket_size apply to the linear tree only: the paper's tree is monopole
+// with the λ rule (the scene loader refuses other choices for it).
 #pragma once
 
 #include <cstddef>
@@ -21,17 +27,49 @@ enum class Method { direct, barnes_hut };
 //   global     the modern baseline: one global tree, particle blocks on the threads.
 enum class Scheme { subdomain, subtree, global };
 
+// Which octree the global scheme walks:
+//   paper   the paper's tree, built by inserting particles one by one (Fig. 1);
+//   linear  built from sorted 63-bit Morton keys (linear_octree.hpp).
+enum class Tree { paper, linear };
+
+// The expansion a linear-tree node's field is computed from: monopole (mass at
+// the centre of mass) or monopole + traceless quadrupole about the centre of mass.
+enum class Multipole { monopole, quadrupole };
+
+// When a node is opened, d = |centre of mass − particle|, l = the node's side:
+//   paper   the paper's rule, open if l / d ≥ λ;
+//   barnes  Barnes' modified rule, open if d < l / θ + δ, δ = |centre of mass −
+//           geometric centre| (linear_octree.hpp says which failure each prevents).
+enum class Criterion { paper, barnes };
+
 std::string_view to_string(Method method);
 std::string_view to_string(Scheme scheme);
+std::string_view to_string(Tree tree);
+std::string_view to_string(Multipole multipole);
+std::string_view to_string(Criterion criterion);
 // Parse "direct" | "barnes_hut" and "subdomain" | "subtree" | "global"; an
 // unknown name throws std::invalid_argument listing the allowed ones.
 Method parse_method(std::string_view name);
 Scheme parse_scheme(std::string_view name);
+// "paper" | "linear", "monopole" | "quadrupole", "paper" | "barnes"; the same errors.
+Tree parse_tree(std::string_view name);
+Multipole parse_multipole(std::string_view name);
+Criterion parse_criterion(std::string_view name);
 
 struct GravitySettings {
   Method method = Method::barnes_hut;
   Scheme scheme = Scheme::global;
-  // λ of section 2: a node whose size / distance(particle, centre of mass) < λ
+  Tree tree = Tree::linear;  // the global scheme's tree
+  Multipole multipole = Multipole::quadrupole;  // linear tree
+  Criterion criterion = Criterion::barnes;      // linear tree
+  // Linear tree: a node with more particles than this is split (measured in
+  // docs/performance/gravity-tree.md).
+  std::size_t bucket_size = 16;
+  // Linear tree under GravityForce: physically reorder the ParticleSet along
+  // the Morton curve at every evaluation (ids survive), so the walk and the
+  // integrator stream through memory.
+  bool reorder = true;
+  // λ of section 2 (θ of Barnes' rule for the linear tree's default criterion): a node whose size / distance(particle, centre of mass) < λ
   // is used as one particle, otherwise it is opened. 0 gives the direct sum.
   double opening = 0.5;
   // Plummer softening ε: forces use |r|² + ε² in place of |r|².

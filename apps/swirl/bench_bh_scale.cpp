@@ -1,0 +1,280 @@
+// `swirl bench bh-scale`: the linear octree (linear_octree.hpp) from 2^12 to
+// 2^23 particles, for each multipole order and opening criterion: time per
+// force evaluation (tree build + walk), the median and 99th-percentile
+// relative force error on a random sample of particles against the direct
+// sum (a full direct sum at 10⁶ particles takes minutes), interactions and
+// nodes per particle, and bytes per particle. Tables via bench.hpp's publish().
+//
+//   swirl bench bh-scale [--sizes 4096,...,8388608] [--threads 2] [--sample 10000] [--opening 0.5]
+//                        [--multipoles monopole,quadrupole] [--criteria paper,barnes] [--bucket 16]
+//                        [--repeats N] [--precision double|float] [--out DIR] [--quick]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "bench.hpp"
+#include "commands.hpp"
+#include "swirl/gravity/barnes_hut.hpp"
+#include "swirl/gravity/initial_conditions.hpp"
+#include "swirl/gravity/pair_law.hpp"
+#include "swirl/parallel/for_blocks.hpp"
+
+namespace swirl::cli {
+namespace {
+
+struct BhScaleArgs {
+  std::vector<std::size_t> sizes;  // default 2^12 .. 2^23
+  std::size_t sample = 10000;
+  double opening = 0.5;
+  double softening = 0.01;
+  std::vector<std::string> multipoles{"monopole", "quadrupole"};
+  std::vector<std::string> criteria{"paper", "barnes"};
+  std::size_t bucket = 16;
+  int repeats = 0;  // 0: 3 below 2^19 particles, else 1
+  std::string precision = "double";
+  std::uint64_t seed = 1;
+};
+
+std::string command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  for (char& c : raw)
+    if (c == '\0') c = ' ';
+  while (!raw.empty() && raw.back() == ' ') raw.pop_back();
+  return raw.empty() ? "swirl bench bh-scale" : raw;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// `count` distinct particle indices, uniformly at random (partial Fisher–Yates).
+std::vector<std::uint32_t> sample_indices(std::size_t n, std::size_t count, std::uint64_t seed) {
+  std::vector<std::uint32_t> all(n);
+  std::iota(all.begin(), all.end(), 0u);
+  std::mt19937_64 rng(seed);
+  count = std::min(count, n);
+  for (std::size_t k = 0; k < count; ++k) {
+    std::uniform_int_distribution<std::size_t> pick(k, n - 1);
+    std::swap(all[k], all[pick(rng)]);
+  }
+  all.resize(count);
+  std::sort(all.begin(), all.end());
+  return all;
+}
+
+// The direct sum in double at the sampled particles: the slow twin.
+template <class Real>
+std::vector<std::array<double, 3>> direct_at(const ParticleSet<Real>& p, const std::vector<std::uint32_t>& at,
+                                             double softening) {
+  std::vector<std::array<double, 3>> out(at.size());
+  const double eps2 = softening * softening;
+  parallel::for_blocks("bh_scale_direct", at.size(), 16, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t k = b; k < e; ++k) {
+      const std::uint32_t i = at[k];
+      const double xi = p.position.x[i], yi = p.position.y[i], zi = p.position.z[i];
+      gravity::Accumulator<double> acc;
+      for (std::size_t j = 0; j < p.size(); ++j) {
+        if (j == i) continue;
+        acc.add(double(p.position.x[j]) - xi, double(p.position.y[j]) - yi, double(p.position.z[j]) - zi,
+                double(p.mass[j]), eps2);
+      }
+      out[k] = {acc.ax, acc.ay, acc.az};
+    }
+  });
+  return out;
+}
+
+template <class Real>
+std::size_t particle_bytes(const ParticleSet<Real>& p) {
+  std::size_t bytes = sizeof(std::uint64_t);
+  for (const auto& f : p.fields()) bytes += std::size_t(f.components) * sizeof(Real);
+  return bytes;
+}
+
+template <class Real>
+void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table& t) {
+  for (std::size_t n : a.sizes) {
+    bench::progress(fmt::format("bh-scale: N = {}: Plummer sphere and the sampled direct sum", n));
+    const ParticleSet<Real> p = gravity::plummer<Real>(n, a.seed);
+    const auto at = sample_indices(n, a.sample, a.seed + 1);
+    const int all = *std::max_element(threads.begin(), threads.end());
+    parallel::set_thread_count(all);
+    const auto reference = direct_at(p, at, a.softening);
+    const int repeats = a.repeats > 0 ? a.repeats : (n < (std::size_t(1) << 19) ? 3 : 1);
+    for (const auto& mp : a.multipoles) {
+      for (const auto& cr : a.criteria) {
+        gravity::GravitySettings g;
+        g.scheme = gravity::Scheme::global;
+        g.tree = gravity::Tree::linear;
+        g.multipole = gravity::parse_multipole(mp);
+        g.criterion = gravity::parse_criterion(cr);
+        g.opening = a.opening;
+        g.softening = a.softening;
+        g.bucket_size = a.bucket;
+        for (int th : threads) {
+          bench::progress(fmt::format("bh-scale: N = {}, {}, {}, {} threads", n, mp, cr, th));
+          parallel::set_thread_count(th);
+          gravity::BarnesHut<Real> tree(g);
+          gravity::GravityField<Real> field;
+          std::vector<double> total, build, walk;
+          for (int r = 0; r < repeats; ++r) {
+            const auto t0 = std::chrono::steady_clock::now();
+            tree.compute(p, field, 1024);
+            total.push_back(seconds_since(t0));
+            build.push_back(tree.stats().tree_build_seconds);
+            walk.push_back(tree.stats().force_seconds);
+          }
+          auto median = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            return v[v.size() / 2];
+          };
+          std::vector<double> err(at.size());
+          for (std::size_t k = 0; k < at.size(); ++k) {
+            double d2 = 0, r2 = 0;
+            for (int c = 0; c < 3; ++c) {
+              const double d = double(field.acceleration[c][at[k]]) - reference[k][std::size_t(c)];
+              d2 += d * d;
+              r2 += reference[k][std::size_t(c)] * reference[k][std::size_t(c)];
+            }
+            err[k] = r2 > 0 ? std::sqrt(d2 / r2) : std::sqrt(d2);
+          }
+          std::sort(err.begin(), err.end());
+          const auto& st = tree.stats();
+          const double tree_bpp = double(st.tree_bytes) / double(n);
+          const double field_bpp = 4.0 * sizeof(Real);
+          t.add({bench::integer(static_cast<long long>(n)), bench::text(mp), bench::text(cr),
+                 bench::text(mp + "/" + cr), bench::integer(th), bench::integer(repeats),
+                 bench::significant(1e3 * median(total), 4), bench::significant(1e3 * median(build), 4),
+                 bench::significant(1e3 * median(walk), 4), bench::significant(1e9 * median(total) / double(n), 4),
+                 bench::significant(err[err.size() / 2], 3),
+                 bench::significant(err[std::size_t(0.99 * double(err.size() - 1))], 3),
+                 bench::number(st.mean_interactions, 0), bench::number(st.mean_nodes_visited, 0),
+                 bench::integer(static_cast<long long>(st.leaves)), bench::number(tree_bpp, 1),
+                 bench::number(tree_bpp + field_bpp + double(particle_bytes(p)), 1),
+                 bench::integer(static_cast<long long>(at.size()))});
+        }
+      }
+    }
+  }
+}
+
+int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
+  if (a.sizes.empty())
+    for (int e = 12; e <= 23; ++e) a.sizes.push_back(std::size_t(1) << e);
+  if (common.quick) {
+    a.sizes = {4096, 8192};
+    a.sample = 500;
+    a.repeats = 1;
+  }
+  for (const auto& m : a.multipoles) gravity::parse_multipole(m);  // reject unknown names before measuring
+  for (const auto& c : a.criteria) gravity::parse_criterion(c);
+  if (a.precision != "double" && a.precision != "float")
+    throw std::invalid_argument(fmt::format("--precision: \"{}\" is neither \"double\" nor \"float\"", a.precision));
+  const auto threads = bench::thread_counts(common);
+  const int previous = parallel::thread_count();
+  bench::Table t;
+  t.title = fmt::format("Linear octree: time, accuracy and memory against N (θ or λ = {}, bucket {}, {})", a.opening,
+                        a.bucket, a.precision);
+  t.columns = {{"particles", "N"},
+               {"multipole", "multipole"},
+               {"criterion", "criterion"},
+               {"config", "config"},
+               {"threads", "threads"},
+               {"repeats", "evaluations"},
+               {"ms_per_evaluation", "ms / evaluation (median)"},
+               {"ms_build", "ms build"},
+               {"ms_walk", "ms walk"},
+               {"ns_per_particle", "ns / particle"},
+               {"error_median", "force error, median"},
+               {"error_p99", "force error, 99th pct"},
+               {"interactions", "interactions / particle"},
+               {"nodes_visited", "nodes / particle"},
+               {"leaves", "leaves"},
+               {"tree_bytes_per_particle", "tree B / particle"},
+               {"total_bytes_per_particle", "total B / particle"},
+               {"sampled", "sampled"}};
+  if (a.precision == "float")
+    measure<float>(a, threads, t);
+  else
+    measure<double>(a, threads, t);
+  parallel::set_thread_count(previous);
+
+  bench::SuiteReport r;
+  r.suite = "bh-scale";
+  r.title = "Barnes-Hut with the linear octree: scaling to millions of particles";
+  std::string sizes;
+  for (std::size_t n : a.sizes) sizes += fmt::format("{}{}", sizes.empty() ? "" : ",", n);
+  r.parameters = {{"sizes", sizes},
+                  {"opening", fmt::format("{}", a.opening)},
+                  {"softening", fmt::format("{}", a.softening)},
+                  {"bucket", fmt::format("{}", a.bucket)},
+                  {"sample", fmt::format("{}", a.sample)},
+                  {"precision", a.precision}};
+  r.tables = {t};
+  r.notes =
+      "One force evaluation = tree build (Morton keys, radix sort, nodes from key prefixes, multipoles) + the "
+      "per-particle walk, on a Plummer sphere (Hénon units, ε as given). Force error: |a_tree − a_direct| / "
+      "|a_direct| on a random sample of particles against the direct sum in double. Interactions: node expansions "
+      "plus particle pairs per particle. Tree B / particle: the tree's memory (nodes, sorted copies, keys, sort "
+      "buffers); total adds the particle fields (ParticleSet) and the field output. `paper` = the paper's rule "
+      "l/d < λ, `barnes` = Barnes' rule d > l/θ + δ (docs/gravity.md).";
+  bench::PlotPanel time;
+  time.x = "particles";
+  time.xlabel = "N";
+  time.ylabel = "ms per force evaluation";
+  time.logx = time.logy = true;
+  time.complexity_guides = true;
+  time.series.push_back({"", "ms_per_evaluation", "", {}, "config"});
+  bench::PlotPanel err;
+  err.x = "particles";
+  err.xlabel = "N";
+  err.ylabel = "relative force error, 99th percentile";
+  err.logx = err.logy = true;
+  err.series.push_back({"", "error_p99", "", {}, "config"});
+  r.plots = {{"bh_scale.png", "Linear octree: time and accuracy against N", {time, err}}};
+  return bench::publish(r, common);
+}
+
+}  // namespace
+
+void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands) {
+  auto args = std::make_shared<BhScaleArgs>();
+  auto common = std::make_shared<bench::CommonArgs>();
+  auto* c = bench_cmd.add_subcommand("bh-scale", "Barnes-Hut linear octree from 2^12 to 2^23 particles: time, "
+                                                 "sampled force error, interactions and bytes per particle");
+  c->add_option("--sizes", args->sizes, "Particle counts (default 4096,...,8388608)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  c->add_option("--threads", common->threads, "Thread counts (default 1 .. all processors)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  c->add_option("--sample", args->sample, "Particles sampled for the force error")->check(CLI::PositiveNumber);
+  c->add_option("--opening", args->opening, "theta (barnes) or lambda (paper)")->check(CLI::Range(0.0, 1.0));
+  c->add_option("--softening", args->softening, "epsilon")->check(CLI::NonNegativeNumber);
+  c->add_option("--multipoles", args->multipoles, "monopole,quadrupole")->delimiter(',');
+  c->add_option("--criteria", args->criteria, "paper,barnes")->delimiter(',');
+  c->add_option("--bucket", args->bucket, "Particles per leaf at most")->check(CLI::PositiveNumber);
+  c->add_option("--repeats", args->repeats, "Timed evaluations per point (default 3 below 2^19, else 1)")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--precision", args->precision, "double or float");
+  c->add_option("--seed", args->seed, "Seed of the Plummer sphere and the sample");
+  c->add_option("--out", common->out, "Output directory for CSV, JSON, markdown and PNG plots (default bench/bh-scale)");
+  c->add_flag("--quick", common->quick, "Tiny sizes: checks the pipeline (CI), measures nothing");
+  commands.push_back({c, [args, common] {
+                        common->command_line = command_line();
+                        return run_bh_scale(*args, *common);
+                      }});
+}
+
+}  // namespace swirl::cli

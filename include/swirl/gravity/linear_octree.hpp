@@ -1,0 +1,149 @@
+// LinearOctree<Real>: the octree swirl's fast gravity stands on, built from
+// sorted space-filling-curve keys instead of particle-by-particle insertion.
+//
+// Build (every pass parallel over fixed blocks, so the tree is the same for
+// any thread count):
+//   1. the bounding cube of the particles; each particle gets a 63-bit Morton
+//      key (21 bits per axis, x lowest: the paper tree's octant numbering);
+//   2. the keys are sorted with parallel::RadixSort (stable: ties by index);
+//      positions and masses are gathered into curve order (the tree's own SoA
+//      copies: order()[s] is the ParticleSet index of sorted slot s);
+//   3. nodes are made level by level from key prefixes: a node is a range
+//      [begin, end) of sorted slots sharing its prefix; a node with more than
+//      bucket_size particles is cut at the 3-bit digit of the next level
+//      (binary searches in the sorted keys) into its non-empty octants, which
+//      are stored next to each other (children contiguous). The finest level
+//      (21) is never split: coincident particles share one leaf;
+//   4. multipoles bottom-up, deepest level first, in double: mass, centre of
+//      mass and the traceless quadrupole Q_ij = Σ m (3 r_i r_j − r² δ_ij)
+//      about the centre of mass (r relative to it), children shifted to the
+//      parent's centre by the parallel-axis theorem.
+//
+// Layout: structure of arrays, one entry per node, nodes in breadth-first
+// order (level by level), so a node's children are first_child ..
+// first_child + child_count − 1. The walk reads only com_*, mass, q*, open2,
+// begin/end and the child range: the layout the group walk and SIMD kernels
+// of the next step need.
+//
+// Opening (a node is used as its expansion iff d² > open2 and the particle is
+// not inside it; d = |centre of mass − particle|, l = node side):
+//   paper   open2 = (l/λ)²: the paper's l/d < λ. Fails when the centre of
+//           mass sits near a corner of the node and λ is large: a particle
+//           just outside the opposite face is "far" from the centre of mass
+//           yet close to the node's mass there, which the expansion moves
+//           away — the error is unbounded (linear_tree_test.cpp,
+//           PaperRuleFailsOnAClumpAtACellCorner...: 68 % at λ = 0.9).
+//   barnes  open2 = (l/θ + δ)², δ = |centre of mass − geometric centre|
+//           (Barnes 1994). An accepted node then has d − δ ≥ l/θ: the
+//           particle is at least l/θ from the cube's centre whatever the mass
+//           distribution, so it is never inside or next to the cube. Prevents
+//           the failure above; for a centred mass (δ = 0) it is the paper's rule.
+// Both: the node holding the particle itself is always opened (its own mass
+// must never enter an expansion: a self-interaction, and d can be ~0); θ or
+// λ = 0 opens everything, and the walk is then the direct sum's very terms.
+//
+// Units: G = 1; lengths as the positions; side of the root cube = root_side().
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <vector>
+
+#include "swirl/core/aligned.hpp"
+#include "swirl/core/particle_set.hpp"
+#include "swirl/gravity/field.hpp"
+#include "swirl/gravity/pair_law.hpp"
+#include "swirl/gravity/settings.hpp"
+#include "swirl/parallel/radix_sort.hpp"
+
+namespace swirl::gravity {
+
+struct LinearTreeSettings {
+  Multipole multipole = Multipole::quadrupole;
+  Criterion criterion = Criterion::barnes;
+  double opening = 0.5;    // λ (paper) or θ (barnes), in [0, 1]
+  double softening = 0.01;  // ε
+  std::size_t bucket_size = 16;
+};
+
+// The node arrays (SoA). Index n in every array is node n; node 0 is the root.
+template <class Real>
+struct LinearNodes {
+  AlignedVector<Real> com_x, com_y, com_z, mass;  // centre of mass, total mass
+  AlignedVector<Real> qxx, qxy, qxz, qyy, qyz;    // traceless quadrupole (qzz = −qxx − qyy)
+  AlignedVector<Real> open2;                      // squared opening radius (see the header)
+  std::vector<std::uint32_t> begin, end;          // sorted particle slots [begin, end)
+  std::vector<std::uint32_t> first_child;         // children: first_child .. + child_count − 1
+  std::vector<std::uint8_t> child_count;          // 0: a leaf
+  std::vector<std::uint8_t> level;                // root 0; side = root side · 2^−level
+  std::vector<std::uint64_t> prefix;              // the key prefix (key >> 3·(21 − level))
+
+  std::size_t size() const { return begin.size(); }
+};
+
+// What a walk did, summed over the particles walked.
+struct WalkCounts {
+  std::uint64_t nodes = 0;         // nodes popped from the visit stack
+  std::uint64_t multipoles = 0;    // node expansions evaluated
+  std::uint64_t pairs = 0;         // particle–particle terms evaluated
+};
+
+template <class Real>
+class LinearOctree {
+ public:
+  static constexpr int kLevels = 21;  // 3 × 21 = 63 key bits
+  static constexpr std::uint32_t npos = std::numeric_limits<std::uint32_t>::max();
+
+  // Builds the tree of all particles of p. block_size: the parallel block of
+  // the per-particle passes (the result does not depend on it).
+  void build(const ParticleSet<Real>& p, const LinearTreeSettings& settings, std::size_t block_size);
+
+  // Declares that the caller permuted its ParticleSet by order() (p.reorder):
+  // ParticleSet index and sorted slot now coincide, order() becomes the identity.
+  void adopt_curve_order();
+
+  // Writes out[order()[s]] for every particle (out resized to the particle count).
+  WalkCounts evaluate(GravityField<Real>& out, std::size_t block_size) const;
+
+  const LinearNodes<Real>& nodes() const { return nodes_; }
+  std::span<const std::uint32_t> order() const { return order_; }
+  std::span<const std::uint64_t> keys() const { return sorter_.keys(); }
+  // Particles in curve order.
+  std::span<const Real> x() const { return x_; }
+  std::span<const Real> y() const { return y_; }
+  std::span<const Real> z() const { return z_; }
+  std::span<const Real> m() const { return m_; }
+  // The root cube: lower corner and side.
+  std::array<double, 3> root_corner() const { return corner_; }
+  double root_side() const { return side_; }
+  int depth() const { return depth_; }
+  std::size_t leaf_count() const;
+  // Bytes held by the tree (nodes, sorted copies, keys, sort buffers).
+  std::size_t bytes() const;
+  const LinearTreeSettings& settings() const { return settings_; }
+
+ private:
+  void make_keys(const ParticleSet<Real>& p, std::size_t block_size);
+  void make_nodes();
+  void make_multipoles();
+  void walk_one(std::size_t s, Accumulator<Real>& acc, WalkCounts& counts) const;
+
+  LinearTreeSettings settings_;
+  LinearNodes<Real> nodes_;
+  parallel::RadixSort<std::uint64_t> sorter_;
+  AlignedVector<std::uint64_t> raw_keys_;
+  std::vector<std::uint32_t> order_;
+  AlignedVector<Real> x_, y_, z_, m_;
+  std::array<double, 3> corner_{};
+  double side_ = 0;
+  int depth_ = 0;
+  std::size_t block_size_ = 1024;
+};
+
+extern template class LinearOctree<float>;
+extern template class LinearOctree<double>;
+
+}  // namespace swirl::gravity

@@ -1,0 +1,460 @@
+// The linear octree: keys, sort, nodes from key prefixes level by level,
+// multipoles bottom-up, and the per-particle non-recursive walk.
+#include "swirl/gravity/linear_octree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string_view>
+#include <utility>
+
+#include "swirl/parallel/for_blocks.hpp"
+
+namespace swirl::gravity {
+
+namespace {
+
+// Particles per block of the walk: neighbours along the curve walk similar
+// paths, and walks differ in cost, so small blocks balance better.
+constexpr std::size_t kWalkBlock = 64;
+// Nodes per block of the level-by-level passes.
+constexpr std::size_t kNodeBlock = 256;
+// The visit stack: each of the ≤ 22 levels leaves at most 7 siblings behind.
+constexpr std::size_t kStackDepth = 8 * (LinearOctree<double>::kLevels + 2);
+
+// Spreads the low 21 bits of v to every third bit.
+constexpr std::uint64_t spread3(std::uint64_t v) {
+  v &= 0x1fffffu;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+// Cell coordinate along one axis from a Morton prefix of `level` digits.
+constexpr std::uint64_t compact3(std::uint64_t v) {
+  v &= 0x1249249249249249ULL;
+  v = (v | v >> 2) & 0x10c30c30c30c30c3ULL;
+  v = (v | v >> 4) & 0x100f00f00f00f00fULL;
+  v = (v | v >> 8) & 0x1f0000ff0000ffULL;
+  v = (v | v >> 16) & 0x1f00000000ffffULL;
+  v = (v | v >> 32) & 0x1fffffULL;
+  return v;
+}
+
+// for_blocks, but a range of one block runs on the calling thread: the top
+// levels of the tree have a handful of nodes, and a parallel region per level
+// costs more than their work on a loaded machine. The same blocks either way.
+template <class Body>
+void node_blocks(std::string_view kernel, std::size_t n, Body&& body) {
+  if (n <= kNodeBlock) {
+    if (n > 0) body(std::size_t(0), n, std::size_t(0));
+    return;
+  }
+  parallel::for_blocks(kernel, n, kNodeBlock, std::forward<Body>(body));
+}
+
+template <class Real>
+Real to_real_radius2(double r2) {
+  constexpr double top = double(std::numeric_limits<Real>::max());
+  return Real(r2 < top ? r2 : top);
+}
+
+}  // namespace
+
+template <class Real>
+void LinearOctree<Real>::build(const ParticleSet<Real>& p, const LinearTreeSettings& settings, std::size_t block_size) {
+  if (block_size == 0) throw std::invalid_argument("linear octree: block size must be at least 1");
+  if (settings.bucket_size < 1) throw std::invalid_argument("linear octree: bucket size must be at least 1");
+  if (p.size() >= npos) throw std::invalid_argument("linear octree: too many particles for 32-bit indices");
+  settings_ = settings;
+  block_size_ = block_size;
+  make_keys(p, block_size);
+  make_nodes();
+  make_multipoles();
+}
+
+template <class Real>
+void LinearOctree<Real>::make_keys(const ParticleSet<Real>& p, std::size_t block_size) {
+  const std::size_t n = p.size();
+  // The bounding cube (a reduction in block order: the same for any thread count).
+  using Bounds = std::array<double, 6>;  // lo xyz, hi xyz
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const Bounds bounds = parallel::reduce_blocks(
+      "linear_octree_bounds", n, block_size, Bounds{inf, inf, inf, -inf, -inf, -inf},
+      [&](std::size_t b, std::size_t e) {
+        Bounds r{inf, inf, inf, -inf, -inf, -inf};
+        for (int a = 0; a < 3; ++a) {
+          const Real* x = p.position[a].data();
+          for (std::size_t i = b; i < e; ++i) {
+            r[std::size_t(a)] = std::min(r[std::size_t(a)], double(x[i]));
+            r[std::size_t(a) + 3] = std::max(r[std::size_t(a) + 3], double(x[i]));
+          }
+        }
+        return r;
+      },
+      [](const Bounds& a, const Bounds& b) {
+        return Bounds{std::min(a[0], b[0]), std::min(a[1], b[1]), std::min(a[2], b[2]),
+                      std::max(a[3], b[3]), std::max(a[4], b[4]), std::max(a[5], b[5])};
+      });
+  double side = n ? std::max({bounds[3] - bounds[0], bounds[4] - bounds[1], bounds[5] - bounds[2]}) : 0.0;
+  if (!(side > 0)) side = 1;  // coincident particles (or none): any cube will do
+  if (!std::isfinite(side)) throw std::invalid_argument("linear octree: non-finite particle positions");
+  side_ = side;
+  corner_ = n ? std::array<double, 3>{bounds[0], bounds[1], bounds[2]} : std::array<double, 3>{0, 0, 0};
+
+  constexpr double cells = double(std::uint64_t(1) << kLevels);
+  const double scale = cells / side;
+  raw_keys_.resize(n);
+  parallel::for_blocks("linear_octree_keys", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t i = b; i < e; ++i) {
+      std::uint64_t key = 0;
+      for (int a = 0; a < 3; ++a) {
+        const double c = std::floor((double(p.position[a][i]) - corner_[std::size_t(a)]) * scale);
+        // The far faces map to the last cell.
+        const std::uint64_t q = c >= cells ? std::uint64_t(cells - 1) : (c > 0 ? std::uint64_t(c) : 0);
+        key |= spread3(q) << a;
+      }
+      raw_keys_[i] = key;
+    }
+  });
+  sorter_.sort(raw_keys_, 3 * kLevels);
+
+  const auto order = sorter_.order();
+  order_.resize(n);
+  x_.resize(n);
+  y_.resize(n);
+  z_.resize(n);
+  m_.resize(n);
+  parallel::for_blocks("linear_octree_gather", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t s = b; s < e; ++s) {
+      const std::uint32_t i = order[s];
+      order_[s] = i;
+      x_[s] = p.position.x[i];
+      y_[s] = p.position.y[i];
+      z_[s] = p.position.z[i];
+      m_[s] = p.mass[i];
+    }
+  });
+}
+
+template <class Real>
+void LinearOctree<Real>::make_nodes() {
+  const std::size_t n = x_.size();
+  const std::span<const std::uint64_t> keys = sorter_.keys();
+  LinearNodes<Real>& t = nodes_;
+  auto resize = [&](std::size_t count) {
+    t.begin.resize(count);
+    t.end.resize(count);
+    t.first_child.resize(count);
+    t.child_count.resize(count);
+    t.level.resize(count);
+    t.prefix.resize(count);
+  };
+  resize(0);
+  depth_ = 0;
+  if (n == 0) {
+    resize(0);
+  } else {
+    resize(1);
+    t.begin[0] = 0;
+    t.end[0] = std::uint32_t(n);
+    t.level[0] = 0;
+    t.prefix[0] = 0;
+    t.first_child[0] = npos;
+    t.child_count[0] = 0;
+  }
+  const std::size_t bucket = settings_.bucket_size;
+  std::vector<std::array<std::uint32_t, 9>> bounds;
+  std::size_t level_begin = 0, level_end = t.size();
+  while (level_begin < level_end) {
+    const std::size_t count = level_end - level_begin;
+    bounds.resize(count);
+    // Where each node's octants start in the sorted keys: a node is split
+    // when it holds more than a bucket and is not at the finest level.
+    node_blocks("linear_octree_split", count, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t k = b; k < e; ++k) {
+        const std::size_t node = level_begin + k;
+        const std::uint32_t first = t.begin[node], last = t.end[node];
+        auto& bound = bounds[k];
+        bound.fill(first);
+        unsigned children = 0;
+        if (last - first > bucket && t.level[node] < kLevels) {
+          const unsigned shift = 3u * unsigned(kLevels - 1 - t.level[node]);
+          bound[8] = last;
+          for (std::uint64_t c = 1; c < 8; ++c)
+            bound[c] = std::uint32_t(std::partition_point(keys.begin() + first, keys.begin() + last,
+                                                          [&](std::uint64_t key) { return ((key >> shift) & 7u) < c; }) -
+                                     keys.begin());
+          for (std::size_t c = 0; c < 8; ++c) children += bound[c] < bound[c + 1] ? 1u : 0u;
+        }
+        t.child_count[node] = std::uint8_t(children);
+      }
+    });
+    // Children of the level, in node order, each node's next to each other.
+    std::size_t next = level_end;
+    for (std::size_t node = level_begin; node < level_end; ++node) {
+      t.first_child[node] = t.child_count[node] ? std::uint32_t(next) : npos;
+      next += t.child_count[node];
+    }
+    if (next >= npos) throw std::invalid_argument("linear octree: too many nodes for 32-bit indices");
+    resize(next);
+    node_blocks("linear_octree_children", count, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t k = b; k < e; ++k) {
+        const std::size_t node = level_begin + k;
+        if (!t.child_count[node]) continue;
+        std::uint32_t child = t.first_child[node];
+        for (std::uint64_t c = 0; c < 8; ++c) {
+          if (bounds[k][c] == bounds[k][c + 1]) continue;
+          t.begin[child] = bounds[k][c];
+          t.end[child] = bounds[k][c + 1];
+          t.level[child] = std::uint8_t(t.level[node] + 1);
+          t.prefix[child] = (t.prefix[node] << 3) | c;
+          t.first_child[child] = npos;
+          t.child_count[child] = 0;
+          ++child;
+        }
+      }
+    });
+    if (next > level_end) depth_ = t.level[level_end];
+    level_begin = level_end;
+    level_end = next;
+  }
+}
+
+template <class Real>
+void LinearOctree<Real>::make_multipoles() {
+  LinearNodes<Real>& t = nodes_;
+  const std::size_t count = t.size();
+  // Moments in double while they are summed; stored in Real at the end.
+  struct Moments {
+    double m, x, y, z, xx, xy, xz, yy, yz;
+  };
+  std::vector<Moments> mom(count);
+  // Nodes are stored level by level: find each level's range.
+  std::vector<std::size_t> level_start(std::size_t(depth_) + 2, count);
+  for (std::size_t node = count; node-- > 0;) level_start[t.level[node]] = node;
+  const bool quadrupole = settings_.multipole == Multipole::quadrupole;
+  for (int level = depth_; level >= 0; --level) {
+    const std::size_t lb = level_start[std::size_t(level)], le = level_start[std::size_t(level) + 1];
+    node_blocks("linear_octree_multipoles", le - lb, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t node = lb + b; node < lb + e; ++node) {
+        const double cell = side_ / double(std::uint64_t(1) << t.level[node]);
+        const std::uint64_t prefix = t.prefix[node];
+        const double centre[3] = {corner_[0] + (double(compact3(prefix)) + 0.5) * cell,
+                                  corner_[1] + (double(compact3(prefix >> 1)) + 0.5) * cell,
+                                  corner_[2] + (double(compact3(prefix >> 2)) + 0.5) * cell};
+        Moments r{};
+        if (t.child_count[node] == 0) {
+          const std::uint32_t first = t.begin[node], last = t.end[node];
+          for (std::uint32_t s = first; s < last; ++s) {
+            r.m += double(m_[s]);
+            r.x += double(m_[s]) * double(x_[s]);
+            r.y += double(m_[s]) * double(y_[s]);
+            r.z += double(m_[s]) * double(z_[s]);
+          }
+          if (last - first == 1) {  // exactly the particle
+            r.x = double(x_[first]);
+            r.y = double(y_[first]);
+            r.z = double(z_[first]);
+          } else if (r.m != 0) {
+            r.x /= r.m;
+            r.y /= r.m;
+            r.z /= r.m;
+          } else {  // massless: at the cube's centre
+            r.x = centre[0];
+            r.y = centre[1];
+            r.z = centre[2];
+          }
+          if (quadrupole && last - first > 1) {
+            for (std::uint32_t s = first; s < last; ++s) {
+              const double dx = double(x_[s]) - r.x, dy = double(y_[s]) - r.y, dz = double(z_[s]) - r.z;
+              const double m = double(m_[s]), d2 = dx * dx + dy * dy + dz * dz;
+              r.xx += m * (3 * dx * dx - d2);
+              r.xy += m * 3 * dx * dy;
+              r.xz += m * 3 * dx * dz;
+              r.yy += m * (3 * dy * dy - d2);
+              r.yz += m * 3 * dy * dz;
+            }
+          }
+        } else {
+          const std::uint32_t c0 = t.first_child[node], c1 = c0 + t.child_count[node];
+          for (std::uint32_t c = c0; c < c1; ++c) {
+            r.m += mom[c].m;
+            r.x += mom[c].m * mom[c].x;
+            r.y += mom[c].m * mom[c].y;
+            r.z += mom[c].m * mom[c].z;
+          }
+          if (r.m != 0) {
+            r.x /= r.m;
+            r.y /= r.m;
+            r.z /= r.m;
+          } else {
+            r.x = centre[0];
+            r.y = centre[1];
+            r.z = centre[2];
+          }
+          if (quadrupole) {
+            // Parallel-axis theorem: a child's quadrupole about the parent's centre of mass.
+            for (std::uint32_t c = c0; c < c1; ++c) {
+              const double dx = mom[c].x - r.x, dy = mom[c].y - r.y, dz = mom[c].z - r.z;
+              const double m = mom[c].m, d2 = dx * dx + dy * dy + dz * dz;
+              r.xx += mom[c].xx + m * (3 * dx * dx - d2);
+              r.xy += mom[c].xy + m * 3 * dx * dy;
+              r.xz += mom[c].xz + m * 3 * dx * dz;
+              r.yy += mom[c].yy + m * (3 * dy * dy - d2);
+              r.yz += mom[c].yz + m * 3 * dy * dz;
+            }
+          }
+        }
+        mom[node] = r;
+      }
+    });
+  }
+
+  for (auto* a : {&t.com_x, &t.com_y, &t.com_z, &t.mass, &t.qxx, &t.qxy, &t.qxz, &t.qyy, &t.qyz, &t.open2})
+    a->resize(count);
+  const double opening = settings_.opening;
+  const bool barnes = settings_.criterion == Criterion::barnes;
+  node_blocks("linear_octree_store", count, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t node = b; node < e; ++node) {
+      const Moments& r = mom[node];
+      t.com_x[node] = Real(r.x);
+      t.com_y[node] = Real(r.y);
+      t.com_z[node] = Real(r.z);
+      t.mass[node] = Real(r.m);
+      t.qxx[node] = Real(r.xx);
+      t.qxy[node] = Real(r.xy);
+      t.qxz[node] = Real(r.xz);
+      t.qyy[node] = Real(r.yy);
+      t.qyz[node] = Real(r.yz);
+      const double cell = side_ / double(std::uint64_t(1) << t.level[node]);
+      double radius = std::numeric_limits<double>::infinity();  // λ = 0 or θ = 0: always open
+      if (opening > 0) {
+        radius = cell / opening;
+        if (barnes) {
+          const std::uint64_t prefix = t.prefix[node];
+          const double dx = corner_[0] + (double(compact3(prefix)) + 0.5) * cell - r.x;
+          const double dy = corner_[1] + (double(compact3(prefix >> 1)) + 0.5) * cell - r.y;
+          const double dz = corner_[2] + (double(compact3(prefix >> 2)) + 0.5) * cell - r.z;
+          radius += std::sqrt(dx * dx + dy * dy + dz * dz);
+        }
+      }
+      t.open2[node] = to_real_radius2<Real>(radius * radius);
+    }
+  });
+}
+
+template <class Real>
+void LinearOctree<Real>::adopt_curve_order() {
+  for (std::size_t s = 0; s < order_.size(); ++s) order_[s] = std::uint32_t(s);
+}
+
+template <class Real>
+void LinearOctree<Real>::walk_one(std::size_t s, Accumulator<Real>& acc, WalkCounts& counts) const {
+  const LinearNodes<Real>& t = nodes_;
+  if (t.size() == 0) return;
+  const Real tx = x_[s], ty = y_[s], tz = z_[s];
+  const Real eps2 = Real(settings_.softening * settings_.softening);
+  const bool quadrupole = settings_.multipole == Multipole::quadrupole;
+  const auto slot = std::uint32_t(s);
+  std::array<std::uint32_t, kStackDepth> stack;
+  std::size_t top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const std::uint32_t n = stack[--top];
+    ++counts.nodes;
+    const Real dx = t.com_x[n] - tx, dy = t.com_y[n] - ty, dz = t.com_z[n] - tz;
+    const Real r2 = dx * dx + dy * dy + dz * dz;
+    const bool holds_target = slot - t.begin[n] < t.end[n] - t.begin[n];  // begin ≤ s < end, unsigned
+    if (!holds_target && r2 > t.open2[n]) {
+      ++counts.multipoles;
+      const Real r2s = r2 + eps2;
+      const Real inv = r2s > Real(0) ? Real(1) / std::sqrt(r2s) : Real(0);
+      const Real inv2 = inv * inv;
+      const Real m_inv3 = t.mass[n] * inv * inv2;
+      acc.ax += m_inv3 * dx;
+      acc.ay += m_inv3 * dy;
+      acc.az += m_inv3 * dz;
+      acc.phi -= t.mass[n] * inv;
+      if (quadrupole) {
+        // φ −= ½ rᵀQr / r⁵, a = −∇φ; r = particle − centre of mass = −(dx, dy, dz).
+        const Real qzz = -(t.qxx[n] + t.qyy[n]);
+        const Real qx = t.qxx[n] * dx + t.qxy[n] * dy + t.qxz[n] * dz;
+        const Real qy = t.qxy[n] * dx + t.qyy[n] * dy + t.qyz[n] * dz;
+        const Real qz = t.qxz[n] * dx + t.qyz[n] * dy + qzz * dz;
+        const Real q = dx * qx + dy * qy + dz * qz;
+        const Real inv5 = inv * inv2 * inv2, inv7 = inv5 * inv2;
+        const Real radial = Real(2.5) * q * inv7;
+        acc.ax += radial * dx - qx * inv5;
+        acc.ay += radial * dy - qy * inv5;
+        acc.az += radial * dz - qz * inv5;
+        acc.phi -= Real(0.5) * q * inv5;
+      }
+    } else if (t.child_count[n] == 0) {
+      const std::uint32_t first = t.begin[n], last = t.end[n];
+      for (std::uint32_t k = first; k < last; ++k) {
+        if (k == slot) continue;
+        acc.add(x_[k] - tx, y_[k] - ty, z_[k] - tz, m_[k], eps2);
+      }
+      counts.pairs += last - first - (holds_target ? 1 : 0);
+    } else {
+      // Reversed, so the first child is visited first.
+      for (std::uint32_t c = t.first_child[n] + t.child_count[n]; c-- > t.first_child[n];) stack[top++] = c;
+    }
+  }
+}
+
+template <class Real>
+WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size) const {
+  const std::size_t n = x_.size();
+  out.resize(n);
+  return parallel::reduce_blocks(
+      "linear_octree_walk", n, std::min(block_size, kWalkBlock), WalkCounts{},
+      [&](std::size_t b, std::size_t e) {
+        WalkCounts counts;
+        for (std::size_t s = b; s < e; ++s) {
+          Accumulator<Real> acc;
+          walk_one(s, acc, counts);
+          const std::uint32_t i = order_[s];
+          out.acceleration.x[i] = acc.ax;
+          out.acceleration.y[i] = acc.ay;
+          out.acceleration.z[i] = acc.az;
+          out.potential[i] = acc.phi;
+        }
+        return counts;
+      },
+      [](WalkCounts a, const WalkCounts& b) {
+        a.nodes += b.nodes;
+        a.multipoles += b.multipoles;
+        a.pairs += b.pairs;
+        return a;
+      });
+}
+
+template <class Real>
+std::size_t LinearOctree<Real>::leaf_count() const {
+  return std::size_t(std::count(nodes_.child_count.begin(), nodes_.child_count.end(), std::uint8_t(0)));
+}
+
+template <class Real>
+std::size_t LinearOctree<Real>::bytes() const {
+  const LinearNodes<Real>& t = nodes_;
+  std::size_t b = 0;
+  for (const auto* a : {&t.com_x, &t.com_y, &t.com_z, &t.mass, &t.qxx, &t.qxy, &t.qxz, &t.qyy, &t.qyz, &t.open2})
+    b += a->capacity() * sizeof(Real);
+  b += (t.begin.capacity() + t.end.capacity() + t.first_child.capacity()) * sizeof(std::uint32_t);
+  b += t.child_count.capacity() + t.level.capacity() + t.prefix.capacity() * sizeof(std::uint64_t);
+  b += (x_.capacity() + y_.capacity() + z_.capacity() + m_.capacity()) * sizeof(Real);
+  b += order_.capacity() * sizeof(std::uint32_t) + raw_keys_.capacity() * sizeof(std::uint64_t);
+  // The sort's key and order arrays, each with its spare (radix_sort.hpp).
+  b += x_.size() * 2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+  return b;
+}
+
+template class LinearOctree<float>;
+template class LinearOctree<double>;
+
+}  // namespace swirl::gravity
