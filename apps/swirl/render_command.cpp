@@ -1,0 +1,144 @@
+// `swirl render`: pictures (PNG) of a run's frames, and a movie with ffmpeg.
+//
+//   swirl render RUN_DIR [--frame K | --all] [--view front|top|iso] [--projection ortho|perspective]
+//                [--color speed|density|pressure|mass] [--size WxH] [--range LO,HI] [--out DIR]
+//                [--movie] [--fps N] [--threads N]
+//
+// Without --frame or --all the last frame is drawn. Pictures go to
+// RUN_DIR/render/particles_NNNNNN.png (or --out DIR), the movie to
+// DIR/movie.mp4. Every file is written atomically.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "commands.hpp"
+#include "swirl/io/atomic_file.hpp"
+#include "swirl/parallel/for_blocks.hpp"
+#include "swirl/render/movie.hpp"
+#include "swirl/render/run_renderer.hpp"
+
+namespace swirl::cli {
+namespace {
+
+struct RenderArgs {
+  std::string run_dir;
+  std::int64_t frame = -1;
+  bool all = false;
+  std::string view = "front";
+  std::string projection;
+  std::string color;
+  std::string size = "1280x720";
+  std::string range;
+  std::string out;
+  bool movie = false;
+  int fps = 25;
+  int threads = 0;
+};
+
+std::pair<int, int> parse_size(const std::string& text) {
+  const auto x = text.find('x');
+  try {
+    std::size_t used_w = 0, used_h = 0;
+    if (x == std::string::npos) throw std::invalid_argument("");
+    const int w = std::stoi(text.substr(0, x), &used_w), h = std::stoi(text.substr(x + 1), &used_h);
+    if (used_w != x || used_h != text.size() - x - 1) throw std::invalid_argument("");
+    return {w, h};
+  } catch (const std::logic_error&) {
+    throw std::invalid_argument("--size '" + text + "': expected WIDTHxHEIGHT in pixels, e.g. 1280x720");
+  }
+}
+
+std::pair<double, double> parse_range(const std::string& text) {
+  const auto sep = text.find_first_of(",:");
+  try {
+    std::size_t used_lo = 0, used_hi = 0;
+    if (sep == std::string::npos) throw std::invalid_argument("");
+    const double lo = std::stod(text.substr(0, sep), &used_lo), hi = std::stod(text.substr(sep + 1), &used_hi);
+    if (used_lo != sep || used_hi != text.size() - sep - 1) throw std::invalid_argument("");
+    return {lo, hi};
+  } catch (const std::logic_error&) {
+    throw std::invalid_argument("--range '" + text + "': expected LO,HI, e.g. 0,3.5");
+  }
+}
+
+int render(const RenderArgs& args) {
+  namespace fs = std::filesystem;
+  render::RenderOptions options;
+  options.view = render::parse_view(args.view);
+  if (!args.projection.empty()) options.projection = render::parse_projection(args.projection);
+  if (!args.color.empty()) options.color = render::parse_quantity(args.color);
+  std::tie(options.width, options.height) = parse_size(args.size);
+  if (!args.range.empty()) options.range = parse_range(args.range);
+  if (args.threads > 0) parallel::set_thread_count(args.threads);
+  // Refuse before drawing anything when the movie cannot be made.
+  if (args.movie && !render::find_program("ffmpeg"))
+    throw std::invalid_argument("--movie: " + render::ffmpeg_missing_hint() +
+                                "; without --movie, --all still draws every frame as PNG");
+
+  render::RunInfo run = render::read_run(args.run_dir);
+  std::vector<io::PvdEntry> frames = run.frames;
+  if (args.frame >= 0) {
+    if (static_cast<std::size_t>(args.frame) >= frames.size())
+      throw std::invalid_argument(fmt::format("{}: no frame {} (the run has frames 0 to {})", args.run_dir, args.frame,
+                                              frames.size() - 1));
+    frames = {frames[static_cast<std::size_t>(args.frame)]};
+  } else if (!args.all && !args.movie) {
+    frames = {frames.back()};
+  }
+  // Options are checked and frame 0 read before the output folder is made.
+  const render::RunRenderer renderer(std::move(run), options);
+  const fs::path out = args.out.empty() ? fs::path(args.run_dir) / "render" : fs::path(args.out);
+  io::ensure_writable_directory(out);
+
+  std::vector<fs::path> written;
+  for (const auto& f : frames) {
+    const fs::path vtp = fs::path(args.run_dir) / f.file;
+    const fs::path png = render::png_path_for(out, vtp);
+    renderer.render_file(vtp, png);
+    written.push_back(png);
+  }
+  const auto [lo, hi] = renderer.range();
+  const std::string colours = renderer.log_density_view()
+                                  ? fmt::format("log surface density {:.3g} to {:.3g}", lo, hi)
+                                  : fmt::format("{} {:.4g} to {:.4g}", render::quantity_name(renderer.quantity()), lo, hi);
+  if (written.size() == 1)
+    fmt::print("swirl render: wrote {} ({})\n", written.front().string(), colours);
+  else
+    fmt::print("swirl render: wrote {} frames to {} ({})\n", written.size(), out.string(), colours);
+  if (args.movie) {
+    const fs::path movie = out / "movie.mp4";
+    render::make_movie(written, movie, args.fps);
+    fmt::print("swirl render: wrote {} ({} frames at {} per second)\n", movie.string(), written.size(), args.fps);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_render_command(CLI::App& app, Commands& commands) {
+  auto args = std::make_shared<RenderArgs>();
+  auto* cmd = app.add_subcommand("render", "Draw a run's frames as PNG pictures (and an MP4 movie with ffmpeg)");
+  cmd->add_option("run_dir", args->run_dir, "Run directory (holds particles.pvd and the .vtp frames)")->required();
+  auto* frame = cmd->add_option("--frame", args->frame, "Draw frame K (default: the last)")->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--all", args->all, "Draw every frame")->excludes(frame);
+  cmd->add_option("--view", args->view, "front (along y), top (along -z) or iso")->check(CLI::IsMember({"front", "top", "iso"}));
+  cmd->add_option("--projection", args->projection, "ortho or perspective (default: perspective for iso)")
+      ->check(CLI::IsMember({"ortho", "perspective"}));
+  cmd->add_option("--color,--colour", args->color, "speed, density, pressure or mass (default: speed; density for gravity)")
+      ->check(CLI::IsMember({"speed", "density", "pressure", "mass"}));
+  cmd->add_option("--size", args->size, "Picture size WIDTHxHEIGHT (default 1280x720)");
+  cmd->add_option("--range", args->range, "Colour range LO,HI (log10 of the surface density for gravity runs)");
+  cmd->add_option("--out,-o", args->out, "Where the pictures go (default: RUN_DIR/render)");
+  cmd->add_flag("--movie", args->movie, "Also make DIR/movie.mp4 of every frame with ffmpeg (implies --all)")->excludes(frame);
+  cmd->add_option("--fps", args->fps, "Movie frames per second (default 25)")->check(CLI::PositiveNumber);
+  cmd->add_option("--threads,-t", args->threads, "Threads (default: all cores); pictures are identical for any count")
+      ->check(CLI::PositiveNumber);
+  commands.push_back({cmd, [args] { return render(*args); }});
+}
+
+}  // namespace swirl::cli

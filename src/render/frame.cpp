@@ -1,0 +1,110 @@
+#include "swirl/render/frame.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "swirl/io/atomic_file.hpp"
+#include "swirl/io/vtp.hpp"
+
+namespace swirl::render {
+namespace {
+
+// The values of a Float32/Float64 array as doubles; components must match.
+std::vector<double> as_doubles(const std::filesystem::path& file, const std::string& name, const io::VtpArray& a,
+                               int components, std::size_t points) {
+  if (a.components != components)
+    throw io::IoError(file.string() + ": array '" + name + "' has " + std::to_string(a.components) +
+                      " components, expected " + std::to_string(components));
+  std::vector<double> out;
+  if (a.type == "Float64") {
+    out = a.values<double>();
+  } else if (a.type == "Float32") {
+    const auto f = a.values<float>();
+    out.assign(f.begin(), f.end());
+  } else {
+    throw io::IoError(file.string() + ": array '" + name + "' is " + a.type + ", expected Float32 or Float64");
+  }
+  if (out.size() != points * static_cast<std::size_t>(components))
+    throw io::IoError(file.string() + ": array '" + name + "' has " + std::to_string(out.size()) +
+                      " values for " + std::to_string(points) + " points");
+  return out;
+}
+
+std::vector<Vec3d> as_vectors(const std::vector<double>& xyz) {
+  std::vector<Vec3d> v(xyz.size() / 3);
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]};
+  return v;
+}
+
+}  // namespace
+
+Quantity parse_quantity(std::string_view name) {
+  if (name == "speed") return Quantity::Speed;
+  if (name == "density") return Quantity::Density;
+  if (name == "pressure") return Quantity::Pressure;
+  if (name == "mass") return Quantity::Mass;
+  throw std::invalid_argument("unknown colour quantity '" + std::string(name) + "' (speed, density, pressure or mass)");
+}
+
+std::string_view quantity_name(Quantity q) {
+  switch (q) {
+    case Quantity::Speed: return "speed";
+    case Quantity::Density: return "density";
+    case Quantity::Pressure: return "pressure";
+    case Quantity::Mass: return "mass";
+  }
+  return "?";
+}
+
+Frame load_frame(const std::filesystem::path& file) {
+  const io::VtpFile vtp = io::read_vtp(file);
+  Frame f;
+  f.file = file;
+  const std::size_t n = vtp.num_points;
+  f.positions = as_vectors(as_doubles(file, "Points", vtp.points, 3, n));
+  if (auto it = vtp.field_data.find("TimeValue"); it != vtp.field_data.end()) {
+    const auto t = as_doubles(file, "TimeValue", it->second, 1, it->second.bytes.empty() ? 0 : 1);
+    if (!t.empty()) f.time = t.front();
+  }
+  auto scalar = [&](const char* name, std::vector<double>& out) {
+    if (auto it = vtp.point_data.find(name); it != vtp.point_data.end()) out = as_doubles(file, name, it->second, 1, n);
+  };
+  if (auto it = vtp.point_data.find("velocity"); it != vtp.point_data.end())
+    f.velocity = as_vectors(as_doubles(file, "velocity", it->second, 3, n));
+  scalar("mass", f.mass);
+  scalar("density", f.density);
+  scalar("pressure", f.pressure);
+  for (const Vec3d& p : f.positions)
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw io::IoError(file.string() + ": a particle position is not finite");
+  return f;
+}
+
+std::vector<double> quantity_values(const Frame& frame, Quantity q) {
+  const std::size_t n = frame.positions.size();
+  auto missing = [&](const char* field) {
+    return io::IoError(frame.file.string() + ": no point array '" + field + "' to colour by " +
+                       std::string(quantity_name(q)));
+  };
+  switch (q) {
+    case Quantity::Speed: {
+      if (frame.velocity.size() != n) throw missing("velocity");
+      std::vector<double> s(n);
+      for (std::size_t i = 0; i < n; ++i) s[i] = norm(frame.velocity[i]);
+      return s;
+    }
+    case Quantity::Density:
+      if (frame.density.size() != n) throw missing("density");
+      return frame.density;
+    case Quantity::Pressure:
+      if (frame.pressure.size() != n) throw missing("pressure");
+      return frame.pressure;
+    case Quantity::Mass:
+      if (frame.mass.size() != n) throw missing("mass");
+      return frame.mass;
+  }
+  throw missing("?");
+}
+
+}  // namespace swirl::render
