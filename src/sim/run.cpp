@@ -86,8 +86,9 @@ class CsvLog {
     std::getline(in, line);  // the header, as this version writes it
     for (std::size_t k = 0; k < rows && std::getline(in, line); ++k) text_ += line + "\n";
   }
-  void add(const std::vector<double>& row) {
+  void add(const std::vector<double>& row, std::string_view last_text_column = {}) {
     for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
+    if (!last_text_column.empty()) text_ += fmt::format(",{}", last_text_column);
     text_ += "\n";
     io::write_file_atomic(path_, text_);
   }
@@ -145,16 +146,22 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   Simulation<Real>& sim = built.sim;
   const sph::SphFluid<Real>* fluid = built.fluid;
   const gravity::GravityForce<Real>* self_gravity = built.self_gravity;
+  sim.set_on_blow_up(options.on_blow_up);
+  const bool adaptive = scene.adaptive_dt;
+  // Adaptive runs log their step history per frame (run.hpp), after the solver's columns.
+  const std::string step_columns = adaptive ? ",step,dt_min,dt_max,dt_next,limited_by" : "";
   std::optional<CsvLog> diagnostics;
   if (fluid)
     diagnostics.emplace(options.out_dir / "diagnostics.csv",
                         "time,kinetic_energy,potential_energy,momentum_x,momentum_y,momentum_z,"
-                        "mean_density_error,max_density_error,mean_neighbours");
+                        "mean_density_error,max_density_error,mean_neighbours" + step_columns);
   else if (self_gravity)
     diagnostics.emplace(options.out_dir / "diagnostics.csv",
                         "time,kinetic_energy,potential_energy,total_energy,relative_energy_error,momentum_x,"
                         "momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z,virial_ratio,"
-                        "mean_nodes_visited");
+                        "mean_nodes_visited" + step_columns);
+  else if (adaptive)
+    diagnostics.emplace(options.out_dir / "diagnostics.csv", "time" + step_columns);
   summary.particles = sim.particles().size();
 
   // Run state that must survive a restart, saved in every checkpoint.
@@ -163,6 +170,9 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   double energy_error = 0;
   double neighbor_sum = 0, nodes_sum = 0;  // per-evaluation means, summed for the summary
   std::uint64_t next_frame = 1, last_frame_step = 0, next_checkpoint = 1;
+  // Adaptive steps: the smallest and largest step since the last frame.
+  double frame_dt_min = std::numeric_limits<double>::infinity(), frame_dt_max = 0;
+  double run_dt_min = std::numeric_limits<double>::infinity(), run_dt_max = 0;  // this invocation's, for the summary
 
   if (options.resume) {
     io::CheckpointValues values;
@@ -183,7 +193,18 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     if (!header)
       throw io::IoError(fmt::format("{}: no valid checkpoint to resume from{}", checkpoint_dir(options.out_dir).string(),
                                     summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
-    sim.resume(header->step);
+    if (adaptive) {
+      // The controller's state; without it the resumed steps would differ.
+      const double previous = value_of(values, "dt_previous", -1), floor = value_of(values, "dt_floor", -1);
+      if (previous < 0 || floor < 0)
+        throw io::IoError(fmt::format("{}: has no adaptive time-step state (dt_previous, dt_floor): not written by an "
+                                      "adaptive run of this swirl", summary.last_checkpoint.string()));
+      sim.resume(header->step, header->time, previous, floor);
+      frame_dt_min = value_of(values, "frame_dt_min", frame_dt_min);
+      frame_dt_max = value_of(values, "frame_dt_max", 0);
+    } else {
+      sim.resume(header->step);
+    }
     summary.first_step = header->step;
     const auto frames = static_cast<std::size_t>(value_of(values, "frames", 0));
     writer.resume(frames);
@@ -201,9 +222,31 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   std::uint64_t target = scene.total_steps();
   if (options.until) target = steps_until(*options.until, scene.dt);
   if (options.steps) target = summary.first_step + *options.steps;
+  // Adaptive steps run to a time (landing on it exactly) unless a step count is asked for.
+  const bool to_time = adaptive && !options.steps && (options.until || scene.end_time);
+  const double end_time = to_time ? options.until.value_or(scene.end_time.value_or(0.0)) : 0.0;
+  auto running = [&] { return to_time ? sim.time() < end_time : sim.step_count() < target; };
+  // Progress of an adaptive run counts the steps still to go at the current step size.
+  auto total_steps = [&] {
+    if (!to_time) return target;
+    const double left = std::max(0.0, (end_time - sim.time()) / sim.proposed_dt());
+    return sim.step_count() + static_cast<std::uint64_t>(std::min(std::ceil(left), 1e18));
+  };
 
   const auto started = std::chrono::steady_clock::now();
   auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(); };
+  // Appends the step history (adaptive runs) and writes the row.
+  auto add_diagnostics = [&](std::vector<double>& row) {
+    if (!adaptive) return diagnostics->add(row);
+    const bool stepped = frame_dt_max > 0;
+    row.insert(row.end(), {double(sim.step_count()), stepped ? frame_dt_min : 0.0, frame_dt_max, sim.proposed_dt()});
+    const auto& tight = sim.limits().tightest();
+    const std::string_view by = sim.proposed_dt() < std::min(tight.dt, scene.dt) ? std::string_view("growth")
+                                : tight.dt <= scene.dt                            ? tight.condition
+                                                                                  : std::string_view("dt_max");
+    diagnostics->add(row, by);
+    frame_dt_min = std::numeric_limits<double>::infinity(), frame_dt_max = 0;
+  };
   auto write_frame = [&] {
     ScopedPhase phase(sim.timers(), "output");
     const auto frame_file = writer.write(sim.particles(), sim.time());
@@ -211,26 +254,36 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     if (options.on_frame) options.on_frame(frame_file, sim.time());
     if (fluid) {
       const auto d = sph::fluid_diagnostics(sim.particles(), scene.gravity, scene.sph->rest_density, scene.block_size);
-      diagnostics->add({sim.time(), d.kinetic_energy, d.potential_energy, d.momentum.x, d.momentum.y, d.momentum.z,
-                        d.mean_density_error, d.max_density_error, fluid->mean_neighbors()});
+      auto row = std::vector<double>{sim.time(), d.kinetic_energy, d.potential_energy, d.momentum.x, d.momentum.y,
+                                     d.momentum.z, d.mean_density_error, d.max_density_error, fluid->mean_neighbors()};
+      add_diagnostics(row);
     } else if (self_gravity) {
       const auto d = gravity::diagnose(sim.particles(), scene.block_size);
       if (std::isnan(initial_energy)) initial_energy = d.total;
       energy_error = initial_energy != 0 ? (d.total - initial_energy) / std::abs(initial_energy) : 0.0;
-      diagnostics->add({sim.time(), d.kinetic, d.potential, d.total, energy_error, d.momentum.x, d.momentum.y,
-                        d.momentum.z, d.angular_momentum.x, d.angular_momentum.y, d.angular_momentum.z, d.virial_ratio,
-                        self_gravity->stats().mean_nodes_visited});
+      auto row = std::vector<double>{sim.time(), d.kinetic, d.potential, d.total, energy_error, d.momentum.x,
+                                     d.momentum.y, d.momentum.z, d.angular_momentum.x, d.angular_momentum.y,
+                                     d.angular_momentum.z, d.virial_ratio, self_gravity->stats().mean_nodes_visited};
+      add_diagnostics(row);
+    } else if (adaptive) {
+      auto row = std::vector<double>{sim.time()};
+      add_diagnostics(row);
     }
   };
   auto write_checkpoint = [&] {
     ScopedPhase phase(sim.timers(), "output");
-    const io::CheckpointValues values{{"frames", double(writer.frames())},
-                                      {"next_frame", double(next_frame)},
-                                      {"last_frame_step", double(last_frame_step)},
-                                      {"next_checkpoint", double(next_checkpoint)},
-                                      {"initial_energy", initial_energy},
-                                      {"neighbor_sum", neighbor_sum},
-                                      {"nodes_sum", nodes_sum}};
+    io::CheckpointValues values{{"frames", double(writer.frames())},
+                                {"next_frame", double(next_frame)},
+                                {"last_frame_step", double(last_frame_step)},
+                                {"next_checkpoint", double(next_checkpoint)},
+                                {"initial_energy", initial_energy},
+                                {"neighbor_sum", neighbor_sum},
+                                {"nodes_sum", nodes_sum}};
+    if (adaptive)
+      values.insert(values.end(), {{"dt_previous", sim.previous_dt()},
+                                   {"dt_floor", sim.dt_floor()},
+                                   {"frame_dt_min", frame_dt_min},
+                                   {"frame_dt_max", frame_dt_max}});
     std::filesystem::create_directories(checkpoint_dir(options.out_dir));
     const auto file = checkpoint_dir(options.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count());
     io::write_checkpoint(file, sim.particles(), {sizeof(Real), sim.particles().size(), hash, sim.step_count(), sim.time()},
@@ -241,9 +294,19 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
       std::filesystem::remove(files[k]);
   };
 
+  // OnBlowUp::Warn: each kind of failed check is reported the 1st, 10th, 100th, ... time.
+  std::vector<std::uint64_t> warned(4, 0);
+  auto warn = [&](const GuardEvent& event) {
+    const std::uint64_t n = ++warned[static_cast<std::size_t>(event.cause)];
+    std::uint64_t decade = 1;
+    while (decade * 10 <= n) decade *= 10;
+    if (n != decade) return;
+    const std::string text = n == 1 ? event.message : fmt::format("({} times so far) {}", n, event.message);
+    if (options.on_warning) options.on_warning(text);
+  };
   // Frame k is due at the first step with time ≥ k·interval; the slack keeps
   // k·interval that lands on a step (up to rounding) on that step. Checkpoints
-  // by time follow the same rule.
+  // by time follow the same rule. Adaptive steps land on k·interval exactly.
   const double interval = scene.output_interval;
   const double slack = 1e-9 * scene.dt;
   auto due = [&](double every, std::uint64_t k) { return sim.time() + slack >= static_cast<double>(k) * every; };
@@ -254,9 +317,25 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
       write_frame();
     }
     summary.bytes_per_particle = bytes_per_particle(sim.particles());
-    if (on_progress) on_progress({sim.step_count(), target, sim.time(), wall()});
-    while (sim.step_count() < target) {
-      sim.step();
+    if (on_progress) on_progress({sim.step_count(), total_steps(), sim.time(), wall()});
+    while (running()) {
+      if (adaptive) {
+        // Land exactly on the next output time and on the end time.
+        std::optional<double> land;
+        if (to_time) land = end_time;
+        if (interval > 0) {
+          const double frame_time = static_cast<double>(next_frame) * interval;
+          if (!land || frame_time < *land) land = frame_time;
+        }
+        sim.step(land);
+        frame_dt_min = std::min(frame_dt_min, sim.last_dt());
+        frame_dt_max = std::max(frame_dt_max, sim.last_dt());
+        run_dt_min = std::min(run_dt_min, sim.last_dt());
+        run_dt_max = std::max(run_dt_max, sim.last_dt());
+      } else {
+        sim.step();
+      }
+      for (auto& event : sim.take_events()) warn(event);
       if (fluid) neighbor_sum += fluid->mean_neighbors();
       if (self_gravity) nodes_sum += self_gravity->stats().mean_nodes_visited;
       if (interval > 0 && due(interval, next_frame)) {
@@ -270,7 +349,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
       }
       const bool stopping = options.stop && options.stop->load();
       if (checkpoint || stopping) write_checkpoint();
-      if (on_progress) on_progress({sim.step_count(), target, sim.time(), wall()});
+      if (on_progress) on_progress({sim.step_count(), total_steps(), sim.time(), wall()});
       if (stopping) {
         summary.interrupted = true;
         break;
@@ -279,25 +358,39 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     if (!summary.interrupted && last_frame_step != sim.step_count()) write_frame();
   } catch (const SimulationError& e) {
     summary.error = e.what();
+    summary.blow_up = std::string(to_string(e.cause()));
   } catch (const io::IoError& e) {
     summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
   } catch (const std::filesystem::filesystem_error& e) {
     summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
   }
 
+  for (std::size_t k = 0; k < warned.size(); ++k)
+    if (warned[k] > 0)
+      summary.warnings.push_back(fmt::format("{} steps failed the '{}' check (--on-blowup=warn)", warned[k],
+                                             to_string(static_cast<BlowUpCause>(k))));
   summary.steps = sim.step_count() - summary.first_step;
   summary.sim_time = sim.time();
   summary.wall_seconds = wall();
   summary.steps_per_second = summary.wall_seconds > 0 ? static_cast<double>(summary.steps) / summary.wall_seconds : 0;
   summary.phases = sim.timers().phases();
   summary.frames = writer.frames();
+  if (fluid && !sim.particles().empty())  // SPH search structures, lists and reorder scratch
+    summary.bytes_per_particle += fluid->scratch_bytes() / sim.particles().size();
   const double evaluations = static_cast<double>(sim.step_count());
   if (fluid)
     summary.metrics.emplace_back("mean_neighbours", evaluations > 0 ? neighbor_sum / evaluations : fluid->mean_neighbors());
+  if (adaptive && run_dt_max > 0) {  // landing steps included
+    summary.metrics.emplace_back("smallest_dt", run_dt_min);
+    summary.metrics.emplace_back("largest_dt", run_dt_max);
+  }
   if (self_gravity) {
     summary.metrics.emplace_back("relative_energy_error", energy_error);  // at the last frame
     summary.metrics.emplace_back("mean_nodes_visited",
                                  evaluations > 0 ? nodes_sum / evaluations : self_gravity->stats().mean_nodes_visited);
+    if (self_gravity->stats().tree_bytes > 0 && summary.particles > 0)
+      summary.metrics.emplace_back("tree_bytes_per_particle",
+                                   double(self_gravity->stats().tree_bytes) / double(summary.particles));
   }
   return summary;
 }

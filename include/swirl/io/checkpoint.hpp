@@ -18,7 +18,11 @@
 // state that changes results today: SPH rebuilds its hash and lists every step,
 // and the gravity sub-domain load balance (nodes explored last step) decides
 // only which thread walks which tree, never a particle's summation order, so a
-// resumed run is bit-identical without it (tested). Whoever adds state
+// resumed run is bit-identical without it (tested). Adaptive time steps keep
+// their controller's state (dt_previous, dt_floor) and the step history of the
+// current frame among the values, and the time reached in the header; the
+// format is unchanged, and run_scene refuses to resume an adaptive run from a
+// checkpoint without those values. Whoever adds state
 // that changes results adds it here and bumps kCheckpointVersion; older
 // versions are refused with a message saying so.
 #pragma once

@@ -28,6 +28,15 @@ SceneSimulation<Real> build_simulation(const scene::Scene& scene) {
   settings.dt = scene.dt;
   settings.block_size = scene.block_size;
   if (scene.walls) settings.box = boundary::BoxCollision<double>{scene.box, scene.restitution};
+  // Time-step conditions and the blow-up guard (sim/step_limits.hpp, docs/stability.md).
+  settings.adaptive = scene.adaptive_dt;
+  settings.dt_min = scene.dt_min;
+  if (scene.sph) {
+    settings.limits.sph = sim::SphStepLimits{scene.sph->smoothing_length, scene.sph->sound_speed, scene.sph->viscosity,
+                                             scene.cfl, scene.force_factor, scene.viscous_factor};
+    if (scene.walls) settings.escape_length = scene.sph->smoothing_length;
+  }
+  if (scene.nbody) settings.limits.gravity = sim::GravityStepLimits{scene.nbody->softening, scene.eta};
   SceneSimulation<Real> out{Simulation<Real>(scene::make_particles<Real>(scene), settings)};
   if (scene.sph) {
     auto model = std::make_unique<sph::SphFluid<Real>>(*scene.sph);

@@ -8,6 +8,15 @@
 // ≥ k·output.interval, the initial state is frame 0, and the final state is
 // always written. SPH runs also write diagnostics.csv: one row per frame with
 // kinetic and potential energy, momentum, density errors and mean neighbours.
+//
+// Blow-ups (sim/blow_up.hpp, docs/stability.md): a failed check stops the run
+// with RunSummary::error naming the step, time, particle, quantity and a fix,
+// keeping every frame and checkpoint written before; OnBlowUp::Warn reports it
+// through RunOptions::on_warning instead (rate-limited) and goes on. With
+// dt = "adaptive" frames land exactly on the output times, the run ends exactly
+// at its end time, and diagnostics.csv gains the step history per frame: steps
+// so far, the smallest and largest step since the previous frame, the step the
+// controller proposes next and the condition that sets it.
 #pragma once
 
 #include <atomic>
@@ -21,6 +30,7 @@
 #include <vector>
 
 #include "swirl/scene/scene.hpp"
+#include "swirl/sim/blow_up.hpp"
 
 namespace swirl::sim {
 
@@ -49,12 +59,18 @@ struct RunOptions {
   // simulated time (e.g. to render it while the run goes on). An exception
   // thrown here stops the run like a write failure.
   std::function<void(const std::filesystem::path& frame, double time)> on_frame;
+
+  // What a failed blow-up check does (stop, or warn and go on).
+  OnBlowUp on_blow_up = OnBlowUp::Stop;
+  // Called with each warning of OnBlowUp::Warn, rate-limited: the 1st, 10th,
+  // 100th, ... failure of each kind of check.
+  std::function<void(const std::string& warning)> on_warning;
 };
 
 // Reported after start() and after every step.
 struct RunProgress {
   std::uint64_t step = 0;
-  std::uint64_t total_steps = 0;
+  std::uint64_t total_steps = 0;  // adaptive steps: an estimate from the current step size
   double sim_time = 0;       // s
   double wall_seconds = 0;   // since the run started stepping
 };
@@ -70,11 +86,12 @@ struct RunSummary {
   double wall_seconds = 0;              // stepping and output, without set-up
   double steps_per_second = 0;
   std::vector<std::pair<std::string, double>> phases;  // seconds per phase
-  std::size_t bytes_per_particle = 0;   // particle storage (all fields and ids) / particles
+  std::size_t bytes_per_particle = 0;   // particle storage (all fields and ids) and SPH search scratch / particles
   std::size_t frames = 0;               // frames written
   // Solver figures, e.g. {"mean_neighbours", 24.9} for SPH runs (mean over steps).
   std::vector<std::pair<std::string, double>> metrics;
   std::string error;                    // empty when the run completed
+  std::string blow_up;                  // the blow-up's cause (to_string(BlowUpCause)) when it stopped the run
   bool interrupted = false;             // stopped by RunOptions::stop (a checkpoint was written)
   std::uint64_t first_step = 0;         // 0, or the checkpoint's step when resumed
   std::filesystem::path last_checkpoint;  // the newest checkpoint written or resumed from
