@@ -1,145 +1,114 @@
-// `swirl bench`: the seeds' performance tables, measured on this machine.
+// `swirl bench SUITE`: the seeds' experiments, reproducible (bench.hpp).
 //
-//   swirl bench sph      steps per second of the thesis's random box (Tables 5.1, 5.3)
-//   swirl bench gravity  seconds for 50 Barnes–Hut iterations (the paper's Table 2)
-#include <chrono>
-#include <map>
+//   swirl bench sph-table  [--sizes ...] [--neighbours 15,25] [--strategy hash,grid] [--settle 500] [--steps N]
+//   swirl bench hash-stats [--particles 15000] [--neighbours 25] [--buckets 24001] [--settle 500] [--steps N]
+//   swirl bench bh-table   [--sizes 1024,...,32768] [--schemes ...] [--iterations 50] [--opening 0.5]
+//   swirl bench bh-lambda  [--sizes 4096,32768] [--lambdas 0.3,0.5,0.7,0.9] [--schemes ...] [--iterations 20]
+//   swirl bench bh-phases  [--sizes ...] [--schemes subtree] [--iterations 50] [--opening 0.5]
+// and on every suite: --out DIR (default bench/results/<suite>), --threads 1,2 (default 1 .. all), --quick.
+#include <fstream>
+#include <iterator>
 #include <memory>
 #include <string>
-#include <utility>
 
 #include <fmt/format.h>
 
 #include "bench.hpp"
 #include "commands.hpp"
-#include "swirl/gravity/bench.hpp"
-#include "swirl/parallel/for_blocks.hpp"
-#include "swirl/scene/load.hpp"
-#include "swirl/sim/build.hpp"
 
 namespace swirl::cli {
 namespace {
 
-// The thesis's benchmark scene (examples/random_box.toml without output).
-const char* kRandomBox = R"(
-particles = 10000
-[random_box]
-neighbours = 25
-[simulation]
-precision = "float"
-dt = 0.003
-steps = 1
-[box]
-restitution = 0.5
-[forces]
-gravity = [0.0, 0.0, 0.0]
-[sph]
-smoothing_length = 0.05
-rest_density = 1000.0
-sound_speed = 3.0
-viscosity = 2.0
-)";
+// The command line as typed (for the records), from /proc/self/cmdline.
+std::string command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  std::string raw((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string out;
+  for (std::size_t i = 0; i < raw.size();) {
+    const std::size_t end = raw.find('\0', i);
+    std::string arg = raw.substr(i, end == std::string::npos ? std::string::npos : end - i);
+    if (i == 0) arg = "swirl";  // not the build directory's path
+    if (!out.empty()) out += ' ';
+    out += arg.find_first_of(" \"'") == std::string::npos ? arg : fmt::format("'{}'", arg);
+    if (end == std::string::npos) break;
+    i = end + 1;
+  }
+  return out.empty() ? "swirl bench" : out;
+}
 
-// Table 5.1 (scalar PPC 970, 15 and 25 neighbours) and Table 5.3 (Cell, 8 SPEs, 25 neighbours), Hz.
-const std::map<std::size_t, std::pair<double, double>> kThesisPpc = {
-    {1000, {312.5, 242.4}}, {2000, {146.2, 118.0}}, {5000, {54.2, 43.7}}, {10000, {24.1, 18.9}},
-    {15000, {14.0, 11.5}},  {20000, {9.6, 7.8}},    {25000, {7.0, 5.9}},  {30000, {5.5, 4.7}},
-    {35000, {4.5, 3.9}}};
-const std::map<std::size_t, double> kThesisCell8 = {{1000, 545.9},  {2000, 519.2},  {5000, 252.1},
-                                                    {10000, 132.7}, {15000, 87.2},  {20000, 66.3},
-                                                    {25000, 53.2},  {30000, 44.5},  {35000, 38.4}};
-
-// The paper's Table 2, -O3, seconds for 50 iterations with 1 and 8 SPEs.
-const std::map<std::size_t, std::pair<double, double>> kPaperTable2 = {
-    {1024, {4.18, 0.68}},   {2048, {10.73, 1.65}},   {4096, {26.49, 3.88}},
-    {8192, {71.41, 9.86}}, {16384, {202.99, 27.71}}, {32768, {533.18, 72.76}}};
-
-std::string thesis_sph(std::size_t n, double k) {
-  const auto ppc = kThesisPpc.find(n);
-  if (ppc == kThesisPpc.end() || (k != 15 && k != 25)) return "-";
-  const double hz = k == 15 ? ppc->second.first : ppc->second.second;
-  if (k == 15) return fmt::format("{:.1f} (PPC 970)", hz);
-  return fmt::format("{:.1f} (PPC 970), {:.1f} (8 SPEs)", hz, kThesisCell8.at(n));
+CLI::App* add_suite(CLI::App* bench, Commands& commands, const std::string& name, const std::string& help,
+                    const std::shared_ptr<bench::CommonArgs>& common, std::function<int()> action) {
+  auto* cmd = bench->add_subcommand(name, help);
+  cmd->add_option("--out", common->out, fmt::format("Output directory for CSV, JSON, markdown and PNG plots (default bench/results/{})", name));
+  cmd->add_option("--threads", common->threads, "Thread counts (default 1 .. all processors)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--quick", common->quick, "Tiny fixed sizes and step counts (replacing the size flags), seconds in all: checks the pipeline (CI), measures nothing");
+  commands.push_back({cmd, [common, action = std::move(action)] {
+                        common->command_line = command_line();
+                        return action();
+                      }});
+  return cmd;
 }
 
 }  // namespace
 
-int bench_sph_table(const BenchArgs& args) {
-  fmt::print("swirl bench sph: the thesis's random box (dt = 0.003 s, h = 0.05 m), {} warm-up + {} timed steps\n",
-             args.warmup, args.steps);
-  fmt::print("{:>8} {:>11} {:>8} {:>10} {:>12} {:>10}   {}\n", "N", "neighbours", "threads", "steps/s", "measured k",
-             "ms/step", "thesis, Hz");
-  for (std::size_t n : args.particles) {
-    for (double k : args.neighbours) {
-      const auto scene = scene::parse_scene(
-          kRandomBox, "bench", std::vector<std::string>{fmt::format("particles={}", n),
-                                                        fmt::format("random_box.neighbours={}", k)});
-      for (int threads : args.threads) {
-        parallel::set_thread_count(threads);
-        auto built = sim::build_simulation<float>(scene);
-        built.sim.start();
-        for (int s = 0; s < args.warmup; ++s) built.sim.step();
-        double neighbours = 0;
-        const auto start = std::chrono::steady_clock::now();
-        for (int s = 0; s < args.steps; ++s) {
-          built.sim.step();
-          neighbours += built.fluid->mean_neighbors();
-        }
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        fmt::print("{:>8} {:>11} {:>8} {:>10.1f} {:>12.1f} {:>10.2f}   {}\n", n, k, threads, args.steps / seconds,
-                   neighbours / args.steps, 1e3 * seconds / args.steps, thesis_sph(n, k));
-        std::fflush(stdout);
-      }
-    }
-  }
-  return 0;
-}
-
-int bench_gravity_table(const BenchArgs& args) {
-  fmt::print("swirl bench gravity: Plummer sphere, lambda = {}, {} iterations, double; seconds (paper: Table 2, -O3)\n",
-             args.opening, args.iterations);
-  fmt::print("{:>8} {:>8} {:>10} {:>10} {:>10} {:>10} {:>11}   {}\n", "N", "threads", "scheme", "total", "tree",
-             "force", "nodes/part", "paper: 1 SPE, 8 SPEs");
-  for (std::size_t n : args.gravity_particles) {
-    for (int threads : args.threads) {
-      for (const auto& name : args.schemes) {
-        gravity::BenchSettings s;
-        s.scheme = gravity::parse_scheme(name);
-        s.n = n;
-        s.opening = args.opening;
-        s.iterations = args.iterations;
-        s.threads = threads;
-        const auto r = gravity::time_iterations(s);
-        const auto paper = kPaperTable2.find(n);
-        fmt::print("{:>8} {:>8} {:>10} {:>10.3f} {:>10.3f} {:>10.3f} {:>11.0f}   {}\n", n, threads, name, r.total,
-                   r.tree_build, r.force, r.mean_nodes_visited,
-                   paper == kPaperTable2.end() ? std::string("-")
-                                               : fmt::format("{:.2f}, {:.2f}", paper->second.first, paper->second.second));
-        std::fflush(stdout);
-      }
-    }
-  }
-  return 0;
-}
-
 void add_bench_commands(CLI::App& app, Commands& commands) {
-  auto bench = std::make_shared<BenchArgs>();
-  auto* bench_cmd = app.add_subcommand("bench", "Measure the seeds' performance tables on this machine");
+  auto* bench_cmd = app.add_subcommand("bench", "The seeds' experiments on this machine: tables, CSV, JSON and plots");
   bench_cmd->require_subcommand(1);
-  auto* bench_sph = bench_cmd->add_subcommand("sph", "Steps per second of the thesis's random box (Tables 5.1, 5.3)");
-  bench_sph->add_option("--particles", bench->particles, "Particle counts")->delimiter(',');
-  bench_sph->add_option("--neighbours", bench->neighbours, "Target neighbour counts")->delimiter(',');
-  bench_sph->add_option("--threads", bench->threads, "Thread counts")->delimiter(',');
-  bench_sph->add_option("--steps", bench->steps, "Timed steps")->check(CLI::PositiveNumber);
-  bench_sph->add_option("--warmup", bench->warmup, "Steps before timing")->check(CLI::NonNegativeNumber);
-  commands.push_back({bench_sph, [bench] { return bench_sph_table(*bench); }});
-  auto* bench_grav = bench_cmd->add_subcommand("gravity", "Seconds for Barnes-Hut iterations (the paper's Table 2)");
-  bench_grav->add_option("--particles", bench->gravity_particles, "Particle counts")->delimiter(',');
-  bench_grav->add_option("--threads", bench->threads, "Thread counts")->delimiter(',');
-  bench_grav->add_option("--schemes", bench->schemes, "subdomain,subtree,global")->delimiter(',');
-  bench_grav->add_option("--iterations", bench->iterations, "Iterations")->check(CLI::PositiveNumber);
-  bench_grav->add_option("--opening", bench->opening, "Opening criterion lambda")->check(CLI::Range(0.0, 1.0));
-  commands.push_back({bench_grav, [bench] { return bench_gravity_table(*bench); }});
+  auto common = std::make_shared<bench::CommonArgs>();
+
+  auto sph = std::make_shared<bench::SphTableArgs>();
+  auto* c = add_suite(bench_cmd, commands, "sph-table",
+                      "SPH random box: the thesis's Tables 5.1, 5.3 and Figures 5.2, 5.3, 5.5, 5.7", common,
+                      [sph, common] { return bench::run_sph_table(*sph, *common); });
+  c->add_option("--sizes", sph->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
+  c->add_option("--neighbours", sph->neighbours, "Measured neighbours per particle to aim at")
+      ->delimiter(',')
+      ->check(CLI::Range(1.0, 500.0));
+  c->add_option("--strategy", sph->strategies, "Neighbour search(es): sph.neighbour_search values (default: the scene's)")
+      ->delimiter(',');
+  c->add_option("--settle", sph->settle, "Steps to settle the random start before timing (the thesis: 3000)")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--steps", sph->steps, "Timed steps (default: about 2e6 particle-steps, 20 .. 1000)")
+      ->check(CLI::PositiveNumber);
+
+  auto hs = std::make_shared<bench::HashStatsArgs>();
+  c = add_suite(bench_cmd, commands, "hash-stats",
+                "Hash table statistics (the thesis's Table 5.2) and the cost of the duplicate check", common,
+                [hs, common] { return bench::run_hash_stats(*hs, *common); });
+  c->add_option("--particles", hs->particles, "Particles")->check(CLI::PositiveNumber);
+  c->add_option("--neighbours", hs->neighbours, "Measured neighbours to aim at")->check(CLI::Range(1.0, 500.0));
+  c->add_option("--buckets", hs->buckets, "Hash table size")->check(CLI::PositiveNumber);
+  c->add_option("--settle", hs->settle, "Steps to settle before measuring")->check(CLI::NonNegativeNumber);
+  c->add_option("--steps", hs->steps, "Timed steps per setting")->check(CLI::PositiveNumber);
+
+  auto bt = std::make_shared<bench::BhTableArgs>();
+  c = add_suite(bench_cmd, commands, "bh-table", "Barnes-Hut: the paper's Table 2 and Figures 9-13", common,
+                [bt, common] { return bench::run_bh_table(*bt, *common); });
+  c->add_option("--sizes", bt->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
+  c->add_option("--schemes", bt->schemes, "subdomain,subtree,global")->delimiter(',');
+  c->add_option("--iterations", bt->iterations, "Iterations")->check(CLI::PositiveNumber);
+  c->add_option("--opening", bt->opening, "Opening criterion lambda")->check(CLI::Range(0.0, 1.0));
+
+  auto bl = std::make_shared<bench::BhLambdaArgs>();
+  c = add_suite(bench_cmd, commands, "bh-lambda", "Barnes-Hut: lambda against time and force error (Figures 14-15)",
+                common, [bl, common] { return bench::run_bh_lambda(*bl, *common); });
+  c->add_option("--sizes", bl->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
+  c->add_option("--lambdas", bl->openings, "Opening criteria")->delimiter(',')->check(CLI::Range(0.0, 1.0));
+  c->add_option("--schemes", bl->schemes, "subdomain,subtree,global")->delimiter(',');
+  c->add_option("--iterations", bl->iterations, "Iterations")->check(CLI::PositiveNumber);
+
+  auto bp = std::make_shared<bench::BhPhasesArgs>();
+  c = add_suite(bench_cmd, commands, "bh-phases", "Barnes-Hut: time per phase beside the paper's Table 1", common,
+                [bp, common] { return bench::run_bh_phases(*bp, *common); });
+  c->add_option("--sizes", bp->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
+  c->add_option("--schemes", bp->schemes, "subdomain,subtree,global")->delimiter(',');
+  c->add_option("--iterations", bp->iterations, "Iterations")->check(CLI::PositiveNumber);
+  c->add_option("--opening", bp->opening, "Opening criterion lambda")->check(CLI::Range(0.0, 1.0));
+
+  // Further suites register here (one line each).
+  add_bench_bh_scale(*bench_cmd, commands);
 }
 
 }  // namespace swirl::cli

@@ -20,6 +20,9 @@ using Commands = std::vector<Command>;
 void add_run_command(CLI::App& app, Commands& commands);
 void add_hash_stats_command(CLI::App& app, Commands& commands);
 void add_bench_commands(CLI::App& app, Commands& commands);
+// `swirl bench bh-scale` (bench_bh_scale.cpp), added to the `bench` subcommand.
+void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands);
 void add_info_command(CLI::App& app, Commands& commands);
+void add_render_command(CLI::App& app, Commands& commands);
 
 }  // namespace swirl::cli

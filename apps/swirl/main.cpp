@@ -4,6 +4,7 @@
 //   swirl hash-stats SCENE [options]                         (hash_stats_command.cpp)
 //   swirl bench SUITE [options]                              (bench.cpp)
 //   swirl info                                               (info_command.cpp)
+//   swirl render RUN_DIR [options]                           (render_command.cpp)
 //
 // Exit status: 0 done, 1 the run failed (blow-up, write error), 2 bad input,
 // 130 / 143 stopped by SIGINT / SIGTERM after writing a checkpoint.
@@ -30,6 +31,7 @@ int main(int argc, char** argv) {
   swirl::cli::add_hash_stats_command(app, commands);
   swirl::cli::add_bench_commands(app, commands);
   swirl::cli::add_info_command(app, commands);
+  swirl::cli::add_render_command(app, commands);
 
   try {
     app.parse(argc, argv);

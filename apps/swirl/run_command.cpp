@@ -3,8 +3,10 @@
 //   swirl run SCENE [--threads N] [--out DIR] [--steps N | --until T] [--set key=value]... [--summary-json FILE]
 //             [--checkpoint-every T] [--checkpoint-every-steps N] [--checkpoint-keep K]
 //   swirl run --resume RUN_DIR [--steps N | --until T] [--threads N] [checkpoint options]
+//   --render-every K: also draw every K-th frame to OUT/render/ (render_command.cpp, swirl/render)
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <csignal>
 #include <memory>
@@ -19,6 +21,8 @@
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/run.hpp"
+#include "swirl/render/font.hpp"
+#include "swirl/render/run_renderer.hpp"
 
 namespace swirl::cli {
 namespace {
@@ -31,10 +35,12 @@ struct RunArgs {
   double until = 0;
   std::vector<std::string> overrides;
   std::string summary_json;
+  std::string on_blowup = "stop";  // "stop" | "warn" (| "off": measurements only, docs/stability.md)
   double checkpoint_every = 0;
   std::uint64_t checkpoint_every_steps = 0;
   std::size_t checkpoint_keep = 2;
   std::string resume;
+  std::uint64_t render_every = 0;  // draw every K-th frame while running (0: off)
 };
 
 // SIGINT/SIGTERM: the first asks the run to stop after the current step (it
@@ -68,7 +74,19 @@ int run(const RunArgs& args) {
   if (args.checkpoint_every > 0) options.checkpoint_every = args.checkpoint_every;
   if (args.checkpoint_every_steps > 0) options.checkpoint_every_steps = args.checkpoint_every_steps;
   options.checkpoint_keep = args.checkpoint_keep;
+  options.on_blow_up = args.on_blowup == "warn" ? OnBlowUp::Warn : args.on_blowup == "off" ? OnBlowUp::Off : OnBlowUp::Stop;
+  options.on_warning = [](const std::string& w) {
+    fmt::print(stderr, "{}swirl run: warning: {}\n", ::isatty(STDERR_FILENO) ? "\n" : "", w);
+  };
   options.stop = &g_stop;
+  if (args.render_every > 0) {
+    // Refused up front (status 2) rather than after the first frame: no .vtp
+    // frames to draw, or no font. A failure later stops the run (status 1).
+    if (std::find(scene.formats.begin(), scene.formats.end(), scene::OutputFormat::Vtp) == scene.formats.end())
+      throw std::invalid_argument("--render-every draws .vtp frames: the scene's output.format has no \"vtp\"");
+    render::Font{};
+    options.on_frame = render::render_every(options.out_dir, args.render_every);
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
@@ -89,6 +107,8 @@ int run(const RunArgs& args) {
   if (!summary.error.empty()) {
     fmt::print(stderr, "swirl run: {}\nswirl run: frames written before the failure are intact in {}\n", summary.error,
                options.out_dir.string());
+    if (!summary.last_checkpoint.empty())
+      fmt::print(stderr, "swirl run: the last checkpoint is {}\n", summary.last_checkpoint.string());
     return 1;
   }
   return 0;
@@ -117,6 +137,10 @@ void add_run_command(CLI::App& app, Commands& commands) {
   run_cmd->add_option("--set", args->overrides, "Override a scene key, e.g. --set box.restitution=0.9")
       ->type_name("KEY=VALUE");
   run_cmd->add_option("--summary-json", args->summary_json, "Also write the closing summary as JSON to FILE");
+  run_cmd->add_option("--on-blowup", args->on_blowup, "When a blow-up check fails: stop (default) or warn and go on")
+      ->check(CLI::IsMember({"stop", "warn", "off"}));
+  run_cmd->add_option("--render-every", args->render_every, "Draw every K-th frame as a PNG in OUT/render (see swirl render)")
+      ->check(CLI::PositiveNumber);
   commands.push_back({run_cmd, [args] { return run(*args); }});
 }
 

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 #include "swirl/core/phase_timers.hpp"
+#include "swirl/gravity/barnes_hut.hpp"
+#include "swirl/gravity/direct_sum.hpp"
 #include "swirl/gravity/gravity_force.hpp"
 #include "swirl/gravity/initial_conditions.hpp"
 #include "swirl/integrate/velocity_verlet.hpp"
@@ -20,6 +23,7 @@ BenchResult run(const BenchSettings& b) {
   GravitySettings g;
   g.method = b.method;
   g.scheme = b.scheme;
+  g.tree = Tree::paper;  // the paper's tables measure the paper's tree (bh-scale measures the linear one)
   g.opening = b.opening;
   g.softening = b.softening;
   GravityForce<Real> gravity(g);
@@ -55,19 +59,96 @@ BenchResult run(const BenchSettings& b) {
   r.nodes = gravity.stats().nodes;
   return r;
 }
-}  // namespace
 
-BenchResult time_iterations(const BenchSettings& b) {
+constexpr std::size_t kBlock = 1024;
+
+// Sets the thread count for its lifetime and restores the previous one.
+struct ThreadScope {
+  explicit ThreadScope(int threads) : previous(parallel::thread_count()) { parallel::set_thread_count(threads); }
+  ~ThreadScope() { parallel::set_thread_count(previous); }
+  ThreadScope(const ThreadScope&) = delete;
+  ThreadScope& operator=(const ThreadScope&) = delete;
+  int previous;
+};
+
+void check(const BenchSettings& b) {
   if (b.n == 0) throw std::invalid_argument("gravity bench: the particle count must be at least 1");
   if (b.iterations < 1) throw std::invalid_argument("gravity bench: iterations must be at least 1");
   if (b.threads < 1) throw std::invalid_argument("gravity bench: threads must be at least 1");
-  const int previous = parallel::thread_count();
-  parallel::set_thread_count(b.threads);
-  struct Restore {
-    int threads;
-    ~Restore() { parallel::set_thread_count(threads); }
-  } restore{previous};
+}
+
+template <class Real>
+std::vector<ForceError> errors_of(const BenchSettings& b, const std::vector<ForceErrorCase>& cases) {
+  const ParticleSet<Real> p = plummer<Real>(b.n, b.seed);
+  // The reference in double from the same (possibly rounded) positions.
+  ParticleSet<double> pd(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    for (int a = 0; a < 3; ++a) pd.position[a][i] = double(p.position[a][i]);
+    pd.mass[i] = double(p.mass[i]);
+  }
+  GravityField<double> exact;
+  direct_sum(pd, b.softening, kBlock, exact);
+  std::vector<ForceError> out;
+  out.reserve(cases.size());
+  std::vector<double> e(p.size());
+  for (const ForceErrorCase& c : cases) {
+    GravitySettings g;
+    g.scheme = c.scheme;
+    g.tree = Tree::paper;
+    g.opening = c.opening;
+    g.softening = b.softening;
+    BarnesHut<Real> tree(g);
+    GravityField<Real> field;
+    tree.compute(p, field, kBlock);
+    parallel::for_blocks("bench_force_error", p.size(), kBlock, [&](std::size_t begin, std::size_t end, std::size_t) {
+      for (std::size_t i = begin; i < end; ++i) {
+        double d2 = 0, r2 = 0;
+        for (int a = 0; a < 3; ++a) {
+          const double d = double(field.acceleration[a][i]) - exact.acceleration[a][i];
+          d2 += d * d;
+          r2 += exact.acceleration[a][i] * exact.acceleration[a][i];
+        }
+        e[i] = r2 > 0 ? std::sqrt(d2 / r2) : std::sqrt(d2);
+      }
+    });
+    ForceError r = summarize_errors(e);
+    r.mean_nodes_visited = tree.stats().mean_nodes_visited;
+    out.push_back(r);
+  }
+  return out;
+}
+}  // namespace
+
+BenchResult time_iterations(const BenchSettings& b) {
+  check(b);
+  const ThreadScope threads(b.threads);
   return b.single_precision ? run<float>(b) : run<double>(b);
+}
+
+ForceError summarize_errors(std::vector<double>& errors) {
+  ForceError r;
+  if (errors.empty()) return r;
+  std::sort(errors.begin(), errors.end());
+  const std::size_t n = errors.size();
+  r.median = errors[(n - 1) / 2];
+  const auto rank = static_cast<std::size_t>(std::ceil(0.99 * static_cast<double>(n)));
+  r.p99 = errors[std::max<std::size_t>(rank, 1) - 1];
+  r.max = errors.back();
+  return r;
+}
+
+std::vector<ForceError> force_errors(const BenchSettings& b, const std::vector<ForceErrorCase>& cases) {
+  check(b);
+  for (const ForceErrorCase& c : cases) {
+    GravitySettings g;
+    g.scheme = c.scheme;
+    g.tree = Tree::paper;
+    g.opening = c.opening;
+    g.softening = b.softening;
+    validate(g);
+  }
+  const ThreadScope threads(b.threads);
+  return b.single_precision ? errors_of<float>(b, cases) : errors_of<double>(b, cases);
 }
 
 }  // namespace swirl::gravity

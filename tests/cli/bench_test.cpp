@@ -1,0 +1,221 @@
+// `swirl bench SUITE --quick`: every suite runs at tiny sizes and writes its
+// CSV (every column, the expected rows, no NaN), JSON (with the build and
+// machine records), markdown and valid PNG plots. Timings are never asserted.
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli/cli_support.hpp"
+
+namespace {
+
+std::vector<std::string> split_line(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') quoted = !quoted;
+    else if (c == ',' && !quoted) {
+      cells.push_back(cell);
+      cell.clear();
+    } else cell += c;
+  }
+  cells.push_back(cell);
+  return cells;
+}
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+};
+
+Csv read_csv(const fs::path& p) {
+  std::istringstream in(slurp(p));
+  Csv csv;
+  std::string line;
+  if (std::getline(in, line)) csv.header = split_line(line);
+  while (std::getline(in, line))
+    if (!line.empty()) csv.rows.push_back(split_line(line));
+  return csv;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// Every column present in order, `rows` rows of the header's width, no NaN or
+// infinity anywhere, and at least one number in every listed numeric column.
+void expect_csv(const fs::path& p, const std::vector<std::string>& columns, std::size_t rows,
+                const std::vector<std::string>& numeric) {
+  ASSERT_TRUE(fs::exists(p)) << p;
+  const Csv csv = read_csv(p);
+  EXPECT_EQ(csv.header, columns) << p;
+  EXPECT_EQ(csv.rows.size(), rows) << p;
+  for (const auto& row : csv.rows) {
+    ASSERT_EQ(row.size(), csv.header.size()) << p;
+    for (const auto& cell : row) {
+      const std::string l = lower(cell);
+      EXPECT_EQ(l.find("nan"), std::string::npos) << p << ": " << cell;
+      EXPECT_EQ(l.find("inf"), std::string::npos) << p << ": " << cell;
+    }
+  }
+  for (const auto& col : numeric) {
+    const auto it = std::find(csv.header.begin(), csv.header.end(), col);
+    ASSERT_NE(it, csv.header.end()) << p << ": " << col;
+    const auto c = static_cast<std::size_t>(it - csv.header.begin());
+    for (const auto& row : csv.rows) {
+      char* end = nullptr;
+      const double v = std::strtod(row[c].c_str(), &end);
+      EXPECT_TRUE(end && *end == '\0' && !row[c].empty()) << p << ": " << col << " = '" << row[c] << "'";
+      EXPECT_GE(v, 0) << p << ": " << col;
+    }
+  }
+}
+
+void expect_png(const fs::path& p) {
+  ASSERT_TRUE(fs::exists(p)) << p;
+  const std::string bytes = slurp(p);
+  ASSERT_GT(bytes.size(), 8u + 25u) << p;
+  EXPECT_EQ(bytes.substr(0, 8), std::string("\x89PNG\r\n\x1a\n", 8)) << p;
+  EXPECT_EQ(bytes.substr(12, 4), "IHDR") << p;
+}
+
+void expect_records(const fs::path& json, const std::string& suite) {
+  ASSERT_TRUE(fs::exists(json)) << json;
+  const std::string j = slurp(json);
+  for (const char* key : {"\"suite\"", "\"date\"", "\"machine\"", "\"cpu\"", "\"logical_processors\"", "\"compiler\"",
+                          "\"build_type\"", "\"git_revision\"", "\"threads\": [1,2]", "\"quick\": true", "\"tables\""})
+    EXPECT_NE(j.find(key), std::string::npos) << json << " lacks " << key;
+  EXPECT_NE(j.find("\"" + suite + "\""), std::string::npos);
+  EXPECT_EQ(lower(j).find("nan"), std::string::npos);
+}
+
+class BenchCli : public Cli {
+ protected:
+  Result bench(const std::string& suite) {
+    return swirl("bench " + suite + " --quick --threads 1,2 --out " + (dir_ / suite).string());
+  }
+};
+
+TEST_F(BenchCli, SphTableQuick) {
+  const Result r = bench("sph-table");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("| N | k aimed |"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("Table 5.1, measured"), std::string::npos);
+  EXPECT_NE(r.out.find("Table 5.3, simulated"), std::string::npos);
+  const auto d = dir_ / "sph-table";
+  // 2 sizes x 2 neighbour counts x 2 thread counts.
+  expect_csv(d / "sph-table.csv",
+             {"particles", "neighbours", "measured_neighbours", "strategy", "threads", "steps", "hz",
+              "us_per_particle_step", "share_hash", "share_search_density", "share_forces", "share_integrate",
+              "share_other", "speedup", "efficiency", "thesis_ppc970_hz", "thesis_cell_1spe_hz", "thesis_cell_8spe_hz",
+              "thesis_cell_8spe_efficiency"},
+             8,
+             {"particles", "measured_neighbours", "threads", "hz", "us_per_particle_step", "share_hash",
+              "share_search_density", "share_forces", "share_integrate", "share_other", "speedup", "efficiency"});
+  expect_csv(d / "sph-table_settle.csv",
+             {"particles", "neighbours", "target", "initial_neighbours", "settled_neighbours", "settle_steps",
+              "settle_seconds", "settle_warnings"},
+             4, {"target", "initial_neighbours", "settled_neighbours"});
+  // N = 1000 is a thesis row: its figures sit beside ours, 500 is not.
+  const Csv csv = read_csv(d / "sph-table.csv");
+  for (const auto& row : csv.rows) {
+    EXPECT_EQ(row[0] == "1000", !row[15].empty()) << row[0];
+  }
+  expect_records(d / "sph-table.json", "sph-table");
+  EXPECT_TRUE(fs::exists(d / "sph-table.md"));
+  // The plots need Debian's python3-matplotlib (make deps installs it).
+  for (const char* png : {"sph-table_cost.png", "sph-table_efficiency.png", "sph-table_subtasks.png"}) expect_png(d / png);
+}
+
+TEST_F(BenchCli, HashStatsQuick) {
+  const Result r = bench("hash-stats");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto d = dir_ / "hash-stats";
+  expect_csv(d / "hash-stats.csv", {"statistic", "swirl", "thesis"}, 8, {"swirl", "thesis"});
+  expect_csv(d / "hash-stats_check.csv",
+             {"threads", "steps", "hz_check_on", "hz_check_off", "gain_check_off_pct", "thesis_ppc970_gain_pct",
+              "thesis_cell_gain_pct"},
+             2, {"hz_check_on", "hz_check_off", "thesis_cell_gain_pct"});
+  expect_records(d / "hash-stats.json", "hash-stats");
+  EXPECT_NE(r.out.find("24001"), std::string::npos) << "the thesis's table size beside ours";
+}
+
+TEST_F(BenchCli, BhTableQuick) {
+  const Result r = bench("bh-table");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto d = dir_ / "bh-table";
+  // 2 sizes x 3 schemes x 2 thread counts.
+  expect_csv(d / "bh-table.csv",
+             {"particles", "scheme", "threads", "iterations", "seconds", "us_per_particle_iteration", "tree_seconds",
+              "force_seconds", "update_seconds", "nodes_visited", "trees", "speedup", "efficiency", "speedup_serial",
+              "paper_1spe_s", "paper_4spe_s", "paper_8spe_s", "paper_speedup_8spe", "paper_trees"},
+             12, {"seconds", "us_per_particle_iteration", "nodes_visited", "trees", "speedup", "efficiency", "speedup_serial"});
+  expect_records(d / "bh-table.json", "bh-table");
+  for (const char* png : {"bh-table_cost.png", "bh-table_efficiency.png"}) expect_png(d / png);
+}
+
+TEST_F(BenchCli, BhLambdaQuick) {
+  const Result r = bench("bh-lambda");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto d = dir_ / "bh-lambda";
+  // 2 sizes x 4 lambdas x 3 schemes.
+  expect_csv(d / "bh-lambda.csv",
+             {"particles", "lambda", "scheme", "threads", "iterations", "ms_per_iteration", "nodes_visited",
+              "error_median", "error_p99", "error_max", "speedup_serial", "paper_speedup_vs_xeon"},
+             24, {"ms_per_iteration", "nodes_visited", "error_median", "error_p99", "error_max", "speedup_serial"});
+  // The error grows with lambda and the percentiles are ordered (not a timing).
+  const Csv csv = read_csv(d / "bh-lambda.csv");
+  for (const auto& row : csv.rows) {
+    EXPECT_LE(std::stod(row[7]), std::stod(row[8]));
+    EXPECT_LE(std::stod(row[8]), std::stod(row[9]));
+    EXPECT_GT(std::stod(row[7]), 0);
+  }
+  expect_records(d / "bh-lambda.json", "bh-lambda");
+  expect_png(d / "bh-lambda.png");
+}
+
+TEST_F(BenchCli, BhPhasesQuick) {
+  const Result r = bench("bh-phases");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto d = dir_ / "bh-phases";
+  expect_csv(d / "bh-phases.csv",
+             {"particles", "scheme", "threads", "tree_ms", "force_ms", "update_ms", "other_ms", "total_ms",
+              "force_overhead_ms", "tree_pct", "force_pct", "update_pct", "other_pct", "paper_tree_pct",
+              "paper_force_pct", "paper_update_pct", "paper_sync_pct"},
+             4, {"tree_ms", "force_ms", "update_ms", "other_ms", "total_ms", "tree_pct", "force_pct"});
+  // The paper's Table 1 as published: 11 rows and Table 2's per-iteration total.
+  expect_csv(d / "bh-phases_paper.csv", {"phase", "kind", "n1024", "n2048", "n4096", "n8192", "n16384", "n32768"}, 12,
+             {"n1024", "n32768"});
+  EXPECT_NE(r.out.find("238.9 ms"), std::string::npos) << "the Table 1 / Table 2 mismatch is stated";
+  expect_records(d / "bh-phases.json", "bh-phases");
+}
+
+TEST_F(BenchCli, WithoutThePlottingToolTheDataAreStillWritten) {
+  const std::string cmd = "SWIRL_PLOT_PYTHON=/nonexistent/python3 ";
+  const auto out = dir_ / "noplot";
+  const auto log = dir_ / "log.txt";
+  const int raw = std::system((cmd + SWIRL_CLI + " bench bh-table --quick --threads 1 --out " + out.string() + " >" +
+                               log.string() + " 2>&1")
+                                  .c_str());
+  ASSERT_TRUE(WIFEXITED(raw));
+  EXPECT_EQ(WEXITSTATUS(raw), 0) << slurp(log);
+  EXPECT_TRUE(fs::exists(out / "bh-table.csv"));
+  EXPECT_TRUE(fs::exists(out / "bh-table.json"));
+  EXPECT_FALSE(fs::exists(out / "bh-table_cost.png"));
+  EXPECT_NE(slurp(log).find("python3-matplotlib"), std::string::npos) << slurp(log);
+}
+
+TEST_F(BenchCli, BadSchemeIsRefusedWithTheAllowedNames) {
+  const Result r = swirl("bench bh-table --quick --schemes subdomain,bogus --out " + (dir_ / "bad").string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("bogus"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("subtree"), std::string::npos) << r.err;
+}
+
+}  // namespace
