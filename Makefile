@@ -4,7 +4,7 @@
 #   make test   install what is missing, build, run every test with CTest, then the
 #               parallel tests under ThreadSanitizer and a fuzz smoke run (60 s per target)
 #
-# Other targets: build, unit-test (CTest only), asan-test (tests under
+# Other targets: build, bench (the seeds' experiments -> docs/performance.md), unit-test (CTest only), asan-test (tests under
 # AddressSanitizer+UBSan, long tests skipped), tsan-test (the parallel tests
 # under ThreadSanitizer), fuzz (libFuzzer smoke run; FUZZ_SECONDS=600 for
 # longer), debug, clean, deps.
@@ -17,11 +17,12 @@ DEMO_OUT ?= out/demo
 # Debian 12 packages needed to build and test swirl.
 DEB_PACKAGES := cmake ninja-build g++ make git pkg-config \
                 libtomlplusplus-dev libcli11-dev libfmt-dev \
-                libgtest-dev libbenchmark-dev
+                libgtest-dev libbenchmark-dev libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core \
+                python3-matplotlib
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps configure build test unit-test demo asan-test tsan-test fuzz debug clean
+.PHONY: all deps configure build test unit-test demo bench asan-test tsan-test fuzz debug clean
 
 all: build
 
@@ -50,6 +51,18 @@ unit-test: build
 demo: build
 	./build/swirl run $(DEMO) --out $(DEMO_OUT)
 	@echo "Open $(DEMO_OUT)/particles.pvd in ParaView."
+
+# The seeds' experiments at their default sizes (each suite's CSV, JSON,
+# markdown and plots into bench/results/<suite>/), then docs/performance.md
+# regenerated from them. About 30 min on the 2-core machine.
+BENCH_OUT ?= bench/results
+bench: build
+	./build/swirl bench sph-table --strategy hash,grid --out $(BENCH_OUT)/sph-table
+	./build/swirl bench hash-stats --out $(BENCH_OUT)/hash-stats
+	./build/swirl bench bh-table --out $(BENCH_OUT)/bh-table
+	./build/swirl bench bh-lambda --out $(BENCH_OUT)/bh-lambda
+	./build/swirl bench bh-phases --out $(BENCH_OUT)/bh-phases
+	/usr/bin/python3 tools/update_performance.py --results $(BENCH_OUT)
 
 asan-test: deps
 	cmake --preset asan

@@ -23,9 +23,12 @@ BUILD=${SWIRL_TSAN_BUILD:-build-tsan}
 JOBS=${JOBS:-$(nproc)}
 # The test executables whose code runs on several threads: the parallel
 # wrappers, the neighbour search, the thread bit-identity tests of both solvers,
-# the gravity kernels and the concurrent atomic file writes.
-DEFAULT_TARGETS="parallel_for_blocks_test spatial_spatial_hash_test sim_threads_test sph_sph_fluid_test
-gravity_schemes_test gravity_direct_sum_test gravity_diagnostics_test gravity_bench_test io_atomic_file_test"
+# the gravity kernels and trees, the renderer's tiles, the adaptive step's
+# reductions and the concurrent atomic file writes.
+DEFAULT_TARGETS="parallel_for_blocks_test parallel_radix_sort_test spatial_spatial_hash_test spatial_cell_grid_test
+sim_threads_test sim_adaptive_test sph_sph_fluid_test sph_grid_strategy_test
+gravity_schemes_test gravity_direct_sum_test gravity_diagnostics_test gravity_bench_test gravity_linear_tree_test
+render_splats_test render_surface_density_test render_run_renderer_test io_atomic_file_test"
 # shellcheck disable=SC2206 # a list of target names, split on white space
 TARGETS=(${SWIRL_TSAN_TARGETS:-$DEFAULT_TARGETS})
 start=$SECONDS

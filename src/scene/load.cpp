@@ -30,7 +30,12 @@ using Keys = std::span<const std::string_view>;
 // suggestion, so a misspelt optional key cannot silently fall back to its default.
 constexpr std::string_view kSections[] = {"simulation", "box",        "forces", "output",
                                           "particles",  "sph",        "random_box", "nbody"};
-constexpr std::string_view kNbodyKeys[] = {"method", "scheme", "opening", "softening", "subdomain_size", "subtree_nodes"};
+constexpr std::string_view kNbodyKeys[] = {"method",         "scheme",        "opening", "softening",
+                                           "subdomain_size", "subtree_nodes", "tree",    "multipole",
+                                           "opening_criterion", "bucket_size"};
+constexpr std::string_view kTrees[] = {"paper", "linear"};                 // the order of gravity::Tree
+constexpr std::string_view kMultipoles[] = {"monopole", "quadrupole"};     // the order of gravity::Multipole
+constexpr std::string_view kCriteria[] = {"paper", "barnes"};              // the order of gravity::Criterion
 constexpr std::string_view kMethods[] = {"direct", "barnes_hut"};            // the order of gravity::Method
 constexpr std::string_view kSchemes[] = {"subdomain", "subtree", "global"};  // the order of gravity::Scheme
 constexpr std::string_view kPlummerKeys[] = {"kind", "count", "seed", "mass_cut", "offset", "velocity"};
@@ -39,7 +44,9 @@ constexpr std::string_view kUniformCubeKeys[] = {"kind", "count", "seed", "side"
 constexpr std::string_view kColdCollapseKeys[] = {"kind", "count", "seed", "offset", "velocity"};
 constexpr std::string_view kCollisionKeys[] = {"kind",      "count",      "seed",     "mass_fraction", "separation",
                                                "impact_parameter", "relative_velocity", "mass_cut", "offset", "velocity"};
-constexpr std::string_view kSimulationKeys[] = {"precision", "dt", "end_time", "steps", "block_size"};
+constexpr std::string_view kSimulationKeys[] = {"precision", "dt",  "end_time",     "steps",          "block_size",
+                                                "dt_max",    "dt_min", "cfl",        "force_factor",   "viscous_factor",
+                                                "eta"};
 constexpr std::string_view kBoxKeys[] = {"min", "max", "restitution"};
 constexpr std::string_view kForcesKeys[] = {"gravity"};
 constexpr std::string_view kOutputKeys[] = {"interval", "format"};
@@ -48,8 +55,11 @@ constexpr std::string_view kRandomKeys[] = {"kind", "min", "max", "count", "seed
 constexpr std::string_view kListKeys[] = {"kind", "positions", "velocities", "mass", "masses"};
 constexpr std::string_view kFluidBlockKeys[] = {"kind", "min", "max", "spacing", "jitter", "seed", "velocity"};
 constexpr std::string_view kSphKeys[] = {"smoothing_length", "neighbours", "rest_density",      "sound_speed",
-                                         "viscosity",        "pressure",   "negative_pressure", "hash"};
+                                         "viscosity",        "pressure",   "negative_pressure", "hash",
+                                         "neighbour_search", "grid"};
 constexpr std::string_view kHashKeys[] = {"buckets", "duplicate_check"};
+constexpr std::string_view kGridKeys[] = {"simd"};
+constexpr std::string_view kNeighbourSearches[] = {"grid", "hash"};  // the order of sph::NeighbourSearch
 constexpr std::string_view kPressureForms[] = {"thesis", "consistent"};  // the order of sph::PressureForm
 constexpr std::string_view kNegativePressures[] = {"keep", "zero"};      // the order of sph::NegativePressure
 constexpr std::string_view kRandomBoxKeys[] = {"neighbours", "seed"};
@@ -310,7 +320,18 @@ void read_simulation(const Table& t, Scene& s) {
   t.only(kSimulationKeys);
   s.precision = static_cast<Precision>(
       t.choice("precision", kPrecisions, static_cast<std::size_t>(s.precision), "precision"));
-  s.dt = t.number("dt", {}, kPositive);
+  // dt: a number, or "adaptive" (then dt_max is the step's cap; see resolve_time_step()).
+  const auto* dt_node = t.find("dt");
+  s.adaptive_dt = dt_node && dt_node->is_string() && dt_node->value<std::string>() == "adaptive";
+  if (!s.adaptive_dt) s.dt = t.number("dt", {}, kPositive);
+  const Range fraction{0, 1, true, false};
+  const Scene defaults;
+  s.cfl = t.number("cfl", defaults.cfl, fraction);
+  s.force_factor = t.number("force_factor", defaults.force_factor, fraction);
+  s.viscous_factor = t.number("viscous_factor", defaults.viscous_factor, fraction);
+  s.eta = t.number("eta", defaults.eta, Range{0, 10, true, false});
+  for (const std::string_view k : {"dt_max", "dt_min"})
+    if (!s.adaptive_dt && t.find(k)) t.fail(k, fmt::format("needs {} = \"adaptive\" (a fixed dt is the step itself)", t.key("dt")));
   const bool has_end_time = t.find("end_time") != nullptr;
   const bool has_steps = t.find("steps") != nullptr;
   if (has_end_time && has_steps)
@@ -320,12 +341,28 @@ void read_simulation(const Table& t, Scene& s) {
     s.end_time = t.number("end_time", {}, kPositive);
     // total_steps() converts end_time / dt to an integer; it must fit.
     const double ratio = *s.end_time / s.dt;
-    if (!(ratio <= 0x1p53))
+    if (!s.adaptive_dt && !(ratio <= 0x1p53))
       t.fail("end_time", fmt::format("needs {:.3g} steps of dt = {}, more than the limit of 2^53", ratio, s.dt));
   } else {
     s.steps = static_cast<std::uint64_t>(t.integer("steps", {}, 1));
   }
   s.block_size = static_cast<std::size_t>(t.integer("block_size", 1024, 1));
+}
+
+// dt = "adaptive": the cap dt_max (scene.dt) and the floor dt_min, once the
+// solvers and the output interval are known.
+void resolve_time_step(const Table& t, Scene& s) {
+  if (!s.adaptive_dt) return;
+  const bool limited = s.sph || s.nbody;
+  std::optional<double> fallback;
+  if (limited && s.output_interval > 0) fallback = s.output_interval;
+  else if (limited && s.end_time) fallback = *s.end_time;
+  if (!t.find("dt_max") && !fallback)
+    t.need("dt_max", limited ? " (dt = \"adaptive\" with neither an output interval nor an end_time needs a cap)"
+                             : " (dt = \"adaptive\" without [sph] or [nbody]: no condition limits the step, so give its size)");
+  s.dt = t.number("dt_max", fallback, kPositive);
+  s.dt_min = t.number("dt_min", 0.0, kNonNegative);
+  if (!(s.dt_min < s.dt)) t.fail("dt_min", fmt::format("must be smaller than {} = {}, got {}", t.key("dt_max"), s.dt, s.dt_min));
 }
 
 void read_box(const Table& t, Scene& s) {
@@ -522,6 +559,11 @@ void read_sph(const Table& top, Scene& s) {
   hash.only(kHashKeys);
   p.buckets = static_cast<std::uint32_t>(hash.integer("buckets", 0, 0, 0xffffffffLL));
   p.duplicate_check = hash.boolean("duplicate_check", true);
+  p.neighbour_search =
+      static_cast<sph::NeighbourSearch>(t.choice("neighbour_search", kNeighbourSearches, 0, "neighbour search"));
+  const Table grid = t.table("grid");
+  grid.only(kGridKeys);
+  p.simd = grid.boolean("simd", true);
   const bool has_h = t.find("smoothing_length") != nullptr, has_k = t.find("neighbours") != nullptr;
   if (has_h && has_k) t.fail("neighbours", fmt::format("cannot be given together with {}", t.key("smoothing_length")));
   if (has_h) {
@@ -557,6 +599,21 @@ void read_nbody(const Table& t, Scene& s) {
   g.softening = t.number("softening", 0.01, kNonNegative);
   g.subdomain_size = static_cast<std::size_t>(t.integer("subdomain_size", 208, 1));
   g.subtree_nodes = static_cast<std::size_t>(t.integer("subtree_nodes", 370, 1));
+  // The paper's schemes walk the paper's tree; only `global` can take the
+  // linear one, and only the linear tree has multipoles and Barnes' rule.
+  const bool global = g.scheme == gravity::Scheme::global;
+  g.tree = static_cast<gravity::Tree>(t.choice("tree", kTrees, global ? 1 : 0, "tree"));
+  if (g.tree == gravity::Tree::linear && !global)
+    t.fail("tree", fmt::format("\"linear\" needs {} = \"global\" (the paper's scheme \"{}\" walks the paper's tree)",
+                               t.key("scheme"), kSchemes[static_cast<std::size_t>(g.scheme)]));
+  const bool linear = g.tree == gravity::Tree::linear;
+  g.multipole = static_cast<gravity::Multipole>(t.choice("multipole", kMultipoles, linear ? 1 : 0, "multipole"));
+  g.criterion = static_cast<gravity::Criterion>(t.choice("opening_criterion", kCriteria, linear ? 1 : 0, "opening criterion"));
+  if (!linear && g.multipole != gravity::Multipole::monopole)
+    t.fail("multipole", "the paper's tree is monopole only (use tree = \"linear\" with scheme = \"global\")");
+  if (!linear && g.criterion != gravity::Criterion::paper)
+    t.fail("opening_criterion", "the paper's tree uses the paper's rule only (use tree = \"linear\" with scheme = \"global\")");
+  g.bucket_size = static_cast<std::size_t>(t.integer("bucket_size", 16, 1, 1 << 20));
   s.nbody = g;
 }
 
@@ -617,6 +674,7 @@ Scene read_scene(const toml::table& root, std::string_view file) {
   // A self-gravitating system floats in open space unless told otherwise.
   s.gravity = forces.vec3("gravity", s.nbody ? Vec3d{} : s.gravity);
   read_output(top.table("output"), s);
+  resolve_time_step(top.table("simulation"), s);
   read_particles(top, s);
   return s;
 }
@@ -716,6 +774,13 @@ std::string canonical_text(const Scene& s) {
   if (s.end_time) put("end_time = {:.17g}\n", *s.end_time);
   if (s.steps) put("steps = {}\n", *s.steps);
   put("block_size = {}\n", s.block_size);
+  // Time-step control, only when it differs from a fixed dt with the default
+  // conditions, so that older scenes keep their hash.
+  const Scene defaults;
+  if (s.adaptive_dt || s.cfl != defaults.cfl || s.force_factor != defaults.force_factor ||
+      s.viscous_factor != defaults.viscous_factor || s.eta != defaults.eta)
+    put("adaptive = {}\ndt_min = {:.17g}\ncfl = {:.17g}\nforce_factor = {:.17g}\nviscous_factor = {:.17g}\neta = {:.17g}\n",
+        s.adaptive_dt, s.dt_min, s.cfl, s.force_factor, s.viscous_factor, s.eta);
   if (s.walls) put("[box]\nmin = {}\nmax = {}\nrestitution = {:.17g}\n", vec(s.box.lo), vec(s.box.hi), s.restitution);
   put("[forces]\ngravity = {}\n", vec(s.gravity));
   put("[output]\ninterval = {:.17g}\nformat = [", s.output_interval);
@@ -729,12 +794,18 @@ std::string canonical_text(const Scene& s) {
         kPressureForms[static_cast<std::size_t>(s.sph->pressure_form)],
         kNegativePressures[static_cast<std::size_t>(s.sph->negative_pressure)], s.sph->buckets,
         s.sph->duplicate_check);
+    put("neighbour_search = \"{}\"\ngrid = {{ simd = {} }}\n",
+        kNeighbourSearches[static_cast<std::size_t>(s.sph->neighbour_search)], s.sph->simd);
   }
   if (s.nbody)
     put("[nbody]\nmethod = \"{}\"\nscheme = \"{}\"\nopening = {:.17g}\nsoftening = {:.17g}\nsubdomain_size = {}\n"
         "subtree_nodes = {}\n",
         kMethods[static_cast<std::size_t>(s.nbody->method)], kSchemes[static_cast<std::size_t>(s.nbody->scheme)],
         s.nbody->opening, s.nbody->softening, s.nbody->subdomain_size, s.nbody->subtree_nodes);
+  if (s.nbody)
+    put("tree = \"{}\"\nmultipole = \"{}\"\nopening_criterion = \"{}\"\nbucket_size = {}\n",
+        kTrees[static_cast<std::size_t>(s.nbody->tree)], kMultipoles[static_cast<std::size_t>(s.nbody->multipole)],
+        kCriteria[static_cast<std::size_t>(s.nbody->criterion)], s.nbody->bucket_size);
   if (s.random_box)
     put("[random_box]\nparticles = {}\nneighbours = {:.17g}\nseed = {}\n", s.random_box->particles,
         s.random_box->neighbors, s.random_box->seed);

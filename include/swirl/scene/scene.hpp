@@ -78,10 +78,20 @@ struct Scene {
   std::string toml;                        // the scene as TOML after --set overrides (parse_scene fills
                                            // it): saved beside a run's outputs so it can be resumed
   Precision precision = Precision::Float;  // simulation.precision, default "float"
-  double dt = 0;                           // simulation.dt, s, > 0
+  double dt = 0;                           // simulation.dt, s, > 0 (adaptive: the largest step, dt_max)
   std::optional<double> end_time;          // simulation.end_time, s (exactly one of end_time, steps)
   std::optional<std::uint64_t> steps;      // simulation.steps
   std::size_t block_size = 1024;           // simulation.block_size: particles per work block, ≥ 1
+
+  // Time-step control (docs/stability.md). dt = "adaptive" chooses every step
+  // from the conditions below (sim/step_limits.hpp); a fixed dt is checked
+  // against them after every step (the blow-up guard).
+  bool adaptive_dt = false;                // simulation.dt = "adaptive"
+  double dt_min = 0;                       // simulation.dt_min, s: adaptive floor; 0 = 1e-6 × the first step
+  double cfl = 0.6;                        // simulation.cfl: C_cfl, SPH Δt ≤ C_cfl·h/(c + |v|max)
+  double force_factor = 0.4;               // simulation.force_factor: C_force, SPH Δt ≤ C_force·sqrt(h/|a|max)
+  double viscous_factor = 0.125;           // simulation.viscous_factor: C_visc, SPH Δt ≤ C_visc·h²·ρ/μ
+  double eta = 0.75;                       // simulation.eta: η, gravity Δt ≤ η·sqrt(ε/|a|max)
 
   bool walls = true;                       // a [box] section: walls; without one, open space
   Box<double> box;                         // box.min, box.max, m (used only with walls)
@@ -113,7 +123,8 @@ struct Scene {
   std::optional<gravity::GravitySettings> nbody;
 
   // Number of steps the scene asks for: `steps`, or ceil(end_time / dt) (a step
-  // that would overshoot end_time by less than 1e-9·dt is not added).
+  // that would overshoot end_time by less than 1e-9·dt is not added). With
+  // adaptive steps and an end_time, the fewest steps (all of dt_max).
   std::uint64_t total_steps() const;
 };
 
