@@ -88,9 +88,9 @@ def main():
                "then `tools/update_performance.py`), or run one suite, e.g. `build/swirl bench sph-table --out "
                "bench/results/sph-table`, and then `tools/update_performance.py`. `swirl bench SUITE --help` lists "
                "the flags; `--quick` checks the pipeline at tiny sizes (CI) and measures nothing.\n")
-    out.append("**Results machine:** " + machine_line(results) + " The machine is shared (2 cores, about five "
-               "engineers building and testing at the same time), so timings are noisy: compare ratios within one "
-               "table, not across tables or days.\n")
+    out.append("**Results machine:** " + machine_line(results) + " Virtual machines like this one are noisy "
+               "(2 cores, shared hosts): compare ratios within one table, not across tables or days. Each point is "
+               "one measurement.\n")
     out.append("## Contents\n")
     for s in suites:
         out.append("- [`swirl bench {0}`](#swirl-bench-{0})".format(s))
