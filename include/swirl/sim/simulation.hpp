@@ -174,7 +174,7 @@ class Simulation {
     }
     if (scan_.non_finite != sim::kNoParticle) throw_non_finite(scan_.non_finite);
     if (!checks) return;
-    if (escape.particle != sim::kNoParticle) report(BlowUpCause::LeftDomain, escape_message(escape));
+    if (escape.found) report(BlowUpCause::LeftDomain, escape_message(escape));
     const sim::StepLimit& tight = limits_.tightest();
     if (!settings_.adaptive && settings_.dt > tight.dt) report(BlowUpCause::TimeStep, condition_message(tight));
   }
@@ -211,7 +211,7 @@ class Simulation {
   // The particle that went furthest outside the box beyond escape_length. By
   // id, not index: the force pass that follows may reorder the particles.
   struct Escape {
-    std::size_t particle = sim::kNoParticle;  // index at the drift; kNoParticle: none
+    bool found = false;
     std::uint64_t id = 0;
     double excess = 0;  // distance outside the box, length units
     double speed = 0;   // |v| during the position update
@@ -276,7 +276,7 @@ class Simulation {
     for (std::size_t i = begin; i < end; ++i) {
       if (outside_by(i) != furthest) continue;
       const auto v = particles_.velocity.get(i).template cast<double>();
-      return {i, static_cast<std::uint64_t>(particles_.id[i]), double(furthest), std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z)};
+      return {true, static_cast<std::uint64_t>(particles_.id[i]), double(furthest), std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z)};
     }
     return out;
   }
