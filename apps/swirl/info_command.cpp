@@ -1,15 +1,20 @@
 // `swirl info`: version, build and machine facts (for bug reports and benchmark records).
 #include <omp.h>
 
+#include <string>
+
 #include <fmt/format.h>
 
 #include "commands.hpp"
 #include "swirl/config.hpp"
+#include "swirl/core/simd_dispatch.hpp"
+#include "swirl/sim/simd_lanes.hpp"
 
 namespace swirl::cli {
 namespace {
 
-// Widest SIMD registers the compiler was allowed to use for this binary.
+// Widest SIMD registers the compiler was allowed to use for the code outside
+// the per-instruction-set kernels.
 int vector_width_bits() {
 #if defined(__AVX512F__)
   return 512;
@@ -28,8 +33,15 @@ int print_info() {
   fmt::print("  build type       {}\n", SWIRL_BUILD_TYPE);
   fmt::print("  compiler         {}\n", SWIRL_COMPILER);
   fmt::print("  OpenMP           {} (threads {}, processors {})\n", _OPENMP, omp_get_max_threads(), omp_get_num_procs());
-  fmt::print("  vector width     {} bits ({} floats, {} doubles)\n", vector_width_bits(), vector_width_bits() / 32,
-             vector_width_bits() / 64);
+  fmt::print("  vector width     {} bits ({} floats, {} doubles) outside the SIMD kernels\n", vector_width_bits(),
+             vector_width_bits() / 32, vector_width_bits() / 64);
+  // The kernels' copies (core/simd_dispatch.hpp); the active one is chosen at run time.
+  std::string copies;
+  for (simd::Isa isa : simd::kCompiledIsas) {
+    copies += fmt::format("{}{}", copies.empty() ? "" : ", ", simd::isa_name(isa));
+    copies += simd::cpu_supports(isa) ? fmt::format(" ({} floats)", sim::simd_float_lanes(isa)) : " (not on this CPU)";
+  }
+  fmt::print("  SIMD kernels     {} active (SWIRL_SIMD to choose); compiled: {}\n", simd::isa_name(simd::active()), copies);
   return 0;
 }
 

@@ -205,7 +205,7 @@ void build_lists(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Re
     }
     L.row_end.clear();
     std::size_t fill = 0;
-    std::array<spatial::IndexRange, 9> ranges{};
+    spatial::NeighbourRanges ranges{};
     std::size_t i = b;
     while (i < e) {
       const std::size_t cell_end = std::min<std::size_t>(e, grid.cell_end(static_cast<std::uint32_t>(i)));

@@ -48,7 +48,7 @@ Pairs grid_pairs(const ParticleSet<Real>& p, Real h, std::size_t block_size, boo
   if (dense) *dense = grid.dense();
   Pairs pairs;
   const Real h2 = h * h;
-  std::array<spatial::IndexRange, 9> ranges{};
+  spatial::NeighbourRanges ranges{};
   for (std::size_t i = 0; i < q.size(); ++i) {
     if (i > 0) {
       EXPECT_LE(grid.keys()[i - 1], grid.keys()[i]);

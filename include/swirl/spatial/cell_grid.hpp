@@ -47,6 +47,11 @@ struct IndexRange {
   std::uint32_t begin = 0, end = 0;
 };
 
+// The most contiguous ranges the 27 cells around a cell can take (9 with
+// row-major keys: the three cells of a row are adjacent), and their holder.
+inline constexpr std::size_t kMaxNeighbourRanges = 9;
+using NeighbourRanges = std::array<IndexRange, kMaxNeighbourRanges>;
+
 template <class Real>
 class SortedCellGrid {
  public:
@@ -104,7 +109,7 @@ class SortedCellGrid {
 
   // Fills out with the ranges of the 27 cells around `key` (non-empty ones
   // only) and returns how many.
-  int neighbour_ranges(std::uint64_t key, std::array<IndexRange, 9>& out) const {
+  int neighbour_ranges(std::uint64_t key, NeighbourRanges& out) const {
     const std::uint64_t nx = dims_[0], ny = dims_[1], nz = dims_[2];
     const std::uint64_t cx = key % nx, rest = key / nx, cy = rest % ny, cz = rest / ny;
     const std::uint64_t x_lo = cx > 0 ? cx - 1 : 0, x_hi = std::min(cx + 1, nx - 1);

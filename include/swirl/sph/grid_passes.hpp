@@ -68,7 +68,7 @@ namespace detail {
 // that a cell's ranges are found once.
 template <class Real, class Body>
 void for_each_in_cells(const spatial::SortedCellGrid<Real>& grid, std::size_t b, std::size_t e, Body&& body) {
-  std::array<spatial::IndexRange, 9> ranges{};
+  spatial::NeighbourRanges ranges{};
   std::size_t i = b;
   while (i < e) {
     const std::size_t cell_end = std::min<std::size_t>(e, grid.cell_end(static_cast<std::uint32_t>(i)));
