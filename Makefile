@@ -47,6 +47,7 @@ test: unit-test tsan-test fuzz
 
 unit-test: build
 	ctest --preset $(PRESET)
+	bash tools/check_simd_objects.sh build$(if $(filter-out release,$(PRESET)),-$(PRESET))
 
 demo: build
 	./build/swirl run $(DEMO) --out $(DEMO_OUT)

@@ -20,9 +20,20 @@
 //                           the loop around the step
 // Hashing and the table build are one timer (SpatialHash::build), so they are
 // reported together.
+//
+// A strategy is a sph.neighbour_search value, optionally followed by grid
+// settings joined with '+': "rows" or "morton" (sph.grid.cell_order),
+// "dense" or "hashed" (sph.grid.table) and "skin=X" (sph.grid.skin in m) or
+// "skin=Xh" (X times the smoothing length), e.g.
+// --strategy grid+morton,grid+rows+skin=0.1h,grid+hashed.
+//
+// Serial fraction: each row with p > 1 threads reports the Karp–Flatt metric
+// e = (1/S − 1/p)/(1 − 1/p), S = t(1)/t(p), per stage (the subtask timers
+// above) and for the whole step, against the same strategy's 1-thread row.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -108,6 +119,7 @@ Settled settle(std::size_t n, double aimed_k, int steps) {
 struct Timing {
   double seconds = 0;  // wall clock of the timed steps
   int steps = 0;
+  double sorts = 0;    // grid sorts per timed step (1 without a skin; 0 for the hash)
   double mean_k = 0;   // mean neighbours over the timed steps
   std::size_t warnings = 0;  // guard events
   double structure = 0, search = 0, forces = 0, integrate = 0;  // seconds per subtask
@@ -123,6 +135,7 @@ Timing time_steps(const scene::Scene& scene, const ParticleSet<float>& start, in
   built.sim.timers() = PhaseTimers{};
   Timing t;
   t.steps = steps;
+  const auto sorts_before = built.fluid->grid_sorts();
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < steps; ++s) {
     built.sim.step();
@@ -131,6 +144,7 @@ Timing time_steps(const scene::Scene& scene, const ParticleSet<float>& start, in
   }
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   t.mean_k /= steps;
+  t.sorts = double(built.fluid->grid_sorts() - sorts_before) / steps;
   for (const auto& [name, sec] : built.sim.timers().phases()) {
     if (name == "forces.search" || name == "forces.density") t.search += sec;
     else if (name == "forces.sph") t.forces += sec;
@@ -147,6 +161,55 @@ int timed_steps(int requested, std::size_t n) {
 }
 
 std::string k_text(double k) { return fmt::format("{}", k); }
+
+// The scene overrides of a strategy "search[+rows|+morton][+skin=X[h]]" (see
+// the file comment); h is the scene's smoothing length.
+std::vector<std::string> strategy_overrides(const std::string& strategy, double h) {
+  std::vector<std::string> out;
+  if (strategy.empty()) return out;
+  std::size_t at = 0;
+  bool first = true;
+  while (at <= strategy.size()) {
+    const std::size_t plus = std::min(strategy.find('+', at), strategy.size());
+    const std::string part = strategy.substr(at, plus - at);
+    at = plus + 1;
+    if (first) {
+      out.push_back(fmt::format("sph.neighbour_search=\"{}\"", part));
+      first = false;
+    } else if (part == "rows" || part == "morton") {
+      out.push_back(fmt::format("sph.grid.cell_order=\"{}\"", part));
+    } else if (part == "dense" || part == "hashed") {
+      out.push_back(fmt::format("sph.grid.table=\"{}\"", part));
+    } else if (part.rfind("skin=", 0) == 0) {
+      std::string value = part.substr(5);
+      const bool in_h = !value.empty() && value.back() == 'h';
+      if (in_h) value.pop_back();
+      std::size_t used = 0;
+      double x = -1;
+      try {
+        x = std::stod(value, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used == 0 || used != value.size() || !(x >= 0))
+        throw std::invalid_argument(fmt::format("--strategy '{}': '{}' is not skin=<metres> or skin=<factor>h", strategy, part));
+      out.push_back(fmt::format("sph.grid.skin={:.17g}", in_h ? x * h : x));
+    } else {
+      throw std::invalid_argument(
+          fmt::format("--strategy '{}': unknown setting '{}' (allowed after '+': rows, morton, dense, hashed, skin=X, "
+                      "skin=Xh)", strategy, part));
+    }
+  }
+  return out;
+}
+
+// Karp–Flatt's experimentally determined serial fraction from the times on 1
+// and p > 1 threads; NaN when a time is missing.
+double karp_flatt(double t1, double tp, int p) {
+  if (!(t1 > 0) || !(tp > 0) || p < 2) return NAN;
+  const double inv_s = tp / t1, inv_p = 1.0 / p;
+  return (inv_s - inv_p) / (1 - inv_p);
+}
 
 }  // namespace
 
@@ -181,7 +244,14 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
                {"thesis_ppc970_hz", "thesis PPC 970 Hz (Table 5.1, measured)"},
                {"thesis_cell_1spe_hz", "thesis Cell 1 SPE Hz (Table 5.3, simulated)"},
                {"thesis_cell_8spe_hz", "thesis Cell 8 SPEs Hz (Table 5.3, simulated)"},
-               {"thesis_cell_8spe_efficiency", "thesis E(8) (Fig. 5.7 = Table 5.3, simulated)"}};
+               {"thesis_cell_8spe_efficiency", "thesis E(8) (Fig. 5.7 = Table 5.3, simulated)"},
+               // After the thesis's columns, so that theirs keep their places.
+               {"sorts_per_step", "grid sorts / step"},
+               {"kf_sort", "Karp-Flatt e: hash/sort"},
+               {"kf_density", "e: search + density"},
+               {"kf_forces", "e: forces"},
+               {"kf_integrate", "e: integrate + collide"},
+               {"kf_step", "e: whole step"}};
   Table settled;
   settled.name = "settle";
   settled.title = "Calibration and settling (Figure 5.1): neighbours at the random start and after settling";
@@ -202,15 +272,24 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
       const auto seed = seeds::thesis_sph_row(n);
       const int steps = timed_steps(a.steps, n);
       for (const auto& strategy : strategies) {
-        std::vector<std::string> extra;
-        if (!strategy.empty()) extra.push_back(fmt::format("sph.neighbour_search=\"{}\"", strategy));
+        const std::vector<std::string> extra =
+            strategy_overrides(strategy, base.scene.sph ? base.scene.sph->smoothing_length : 0.0);
         const scene::Scene scene = random_box(n, base.target_k, extra);
         double one_thread = 0;
+        Timing one;
         for (int p : threads) {
           progress(fmt::format("sph-table: N = {}, k = {}{}: {} steps on {} thread(s)", n, k,
                                strategy.empty() ? "" : ", " + strategy, steps, p));
           const Timing m = time_steps(scene, base.particles, steps, p);
-          if (p == 1) one_thread = m.seconds;
+          if (p == 1) {
+            one_thread = m.seconds;
+            one = m;
+          }
+          const bool has_one = one.seconds > 0 && p > 1;
+          auto kf = [&](double t1, double tp) {
+            const double e = has_one ? karp_flatt(t1, tp, p) : NAN;
+            return std::isfinite(e) ? number(e, 3) : none();
+          };
           const double other = std::max(0.0, m.seconds - m.structure - m.search - m.forces - m.integrate);
           const double pct = 100 / m.seconds;
           const bool k15 = k == 15, k25 = k == 25;
@@ -223,7 +302,9 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
                  seed && (k15 || k25) ? number(k15 ? seed->ppc970_k15_hz : seed->ppc970_k25_hz, 1) : none(),
                  seed && k25 ? number(seed->cell_1spe_hz, 1) : none(),
                  seed && k25 ? number(seed->cell_8spe_hz, 1) : none(),
-                 seed && k25 ? number(seed->cell_8spe_hz / seed->cell_1spe_hz / seeds::kThesisCellSpes, 2) : none()});
+                 seed && k25 ? number(seed->cell_8spe_hz / seed->cell_1spe_hz / seeds::kThesisCellSpes, 2) : none(),
+                 number(m.sorts, 3), kf(one.structure, m.structure), kf(one.search, m.search),
+                 kf(one.forces, m.forces), kf(one.integrate, m.integrate), kf(one.seconds, m.seconds)});
         }
       }
     }
@@ -257,7 +338,10 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
       "`forces.density`, which searches on the fly, as does its force pass), forces = `forces.sph`, integrate + collide = `integrate`, other "
       "= the rest of the wall time. The thesis's Figure 5.2 says the forces take less than {:.0f} % on the PPC "
       "970; its Figure 5.6 says hashing + search take {:.0f} % on one SPE. E(p) = S(p)/p with S(p) = t(1 "
-      "thread)/t(p) (eq. 5.1); the thesis's E(8) is Table 5.3's 8-SPE rate over 8 times its 1-SPE rate.",
+      "thread)/t(p) (eq. 5.1); the thesis's E(8) is Table 5.3's 8-SPE rate over 8 times its 1-SPE rate. "
+      "Karp-Flatt e = (1/S - 1/p)/(1 - 1/p) per stage (the subtask timers) and for the whole step, S from the "
+      "strategy's 1-thread row: the serial fraction the timings imply (0 = perfect scaling, 1 = none). "
+      "\"grid sorts / step\" < 1 when a Verlet skin (strategy +skin=...) let steps reuse the last sort.",
       a.settle, seeds::kThesisSettleSteps, 100 * seeds::kThesisPpcForceShareBelow,
       100 * seeds::kThesisSpeHashSearchShare);
 

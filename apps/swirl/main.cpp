@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "swirl/core/simd_dispatch.hpp"
 #include "swirl/config.hpp"
 #include "swirl/scene/load.hpp"
 
@@ -40,6 +41,7 @@ int main(int argc, char** argv) {
   }
 
   try {
+    swirl::simd::active();  // a bad SWIRL_SIMD stops here, before any work
     for (const auto& command : commands)
       if (command.app->parsed()) return command.action();
     fmt::print(stderr, "swirl: error: no command given\n");

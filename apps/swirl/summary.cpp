@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "cli.hpp"
+#include "swirl/core/simd_dispatch.hpp"
 
 namespace swirl::cli {
 namespace {
@@ -33,6 +34,7 @@ std::string summary_text(const sim::RunSummary& s) {
   out += fmt::format("  wall time        {:.3f} s\n", s.wall_seconds);
   out += fmt::format("  steps per second {:.2f}\n", s.steps_per_second);
   out += fmt::format("  threads          {}\n", s.threads);
+  out += fmt::format("  SIMD kernels     {}\n", simd::isa_name(simd::active()));
   out += fmt::format("  bytes/particle   {}\n", s.bytes_per_particle);
   out += fmt::format("  frames           {} in {}\n", s.frames, s.out_dir.string());
   for (const auto& [name, value] : s.metrics) out += fmt::format("  {:<16} {:.6g}\n", name, value);
@@ -50,11 +52,12 @@ std::string summary_json(const sim::RunSummary& s) {
     phases += fmt::format("{}{}: {:.9g}", phases.empty() ? "" : ", ", json_string(name), seconds);
   return fmt::format(
       "{{\n"
-      "  \"scene\": {},\n  \"precision\": {},\n  \"out_dir\": {},\n  \"threads\": {},\n"
+      "  \"scene\": {},\n  \"precision\": {},\n  \"out_dir\": {},\n  \"threads\": {},\n  \"simd\": \"{}\",\n"
       "  \"particles\": {},\n  \"steps\": {},\n  \"sim_time\": {:.17g},\n  \"wall_seconds\": {:.9g},\n"
       "  \"steps_per_second\": {:.9g},\n  \"phase_seconds\": {{{}}},\n  \"bytes_per_particle\": {},\n"
       "  \"frames\": {},\n{}  \"completed\": {},\n  \"error\": {}\n}}\n",
-      json_string(s.scene_file), json_string(s.precision), json_string(s.out_dir.string()), s.threads, s.particles,
+      json_string(s.scene_file), json_string(s.precision), json_string(s.out_dir.string()), s.threads,
+      simd::isa_name(simd::active()), s.particles,
       s.steps, s.sim_time, s.wall_seconds, s.steps_per_second, phases, s.bytes_per_particle, s.frames, metrics,
       s.error.empty() ? "true" : "false", s.error.empty() ? "null" : json_string(s.error));
 }

@@ -13,6 +13,11 @@
 // Counters: pairs_per_s (neighbour pairs, self excluded, processed per second:
 // the end-to-end rate of the pass) and ns_per_particle.
 // Run e.g.  sph_bench --benchmark_filter='BM_Density/1000000'
+//
+// The SIMD passes run the instruction set of simd::active() (the widest this
+// CPU runs; core/simd_dispatch.hpp), named in each label ("simd avx512"). To
+// compare the copies of one binary, run it once per set:
+//   SWIRL_SIMD=sse2 sph_bench ...;  SWIRL_SIMD=avx2 ...;  SWIRL_SIMD=avx512 ...
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
@@ -21,6 +26,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #if defined(__AVX512F__)
@@ -28,6 +34,7 @@
 #endif
 
 #include "swirl/core/random.hpp"
+#include "swirl/core/simd_dispatch.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sim/simulation.hpp"
 #include "swirl/sph/grid_passes.hpp"
@@ -71,6 +78,11 @@ sph::GridPassConstants<Real> constants(const sph::SphParameters& s) {
   k.pressure_floor = -1e30f;
   k.mu = Real(s.viscosity);
   return k;
+}
+
+// "simd <instruction set>" or "scalar".
+std::string simd_label(bool simd) {
+  return simd ? "simd " + std::string(simd::isa_name(simd::active())) : "scalar";
 }
 
 struct Threads {
@@ -150,7 +162,7 @@ void grid_pass(benchmark::State& state) {
     benchmark::DoNotOptimize(p.acceleration.x.data());
   }
   report(state, n, fluid.mean_neighbors());
-  state.SetLabel(simd ? "simd" : "scalar");
+  state.SetLabel(simd_label(simd));
 }
 void BM_Density(benchmark::State& state) { grid_pass<false>(state); }
 void BM_Forces(benchmark::State& state) { grid_pass<true>(state); }
@@ -173,7 +185,7 @@ void BM_Step(benchmark::State& state) {
   for (auto _ : state) sim.step();
   report(state, n, fluid->mean_neighbors());
   state.counters["bytes_per_particle"] = double(fluid->scratch_bytes()) / double(n) + 16 * sizeof(Real) + 8;
-  state.SetLabel(std::string(grid ? "grid" : "hash") + (state.range(3) ? "" : " scalar"));
+  state.SetLabel(std::string(grid ? "grid " : "hash ") + simd_label(grid && state.range(3) != 0));
 }
 
 // The alternative to computing on the fly: neighbour lists (CSR per work

@@ -114,7 +114,8 @@ TEST_F(BenchCli, SphTableQuick) {
              {"particles", "neighbours", "measured_neighbours", "strategy", "threads", "steps", "hz",
               "us_per_particle_step", "share_hash", "share_search_density", "share_forces", "share_integrate",
               "share_other", "speedup", "efficiency", "thesis_ppc970_hz", "thesis_cell_1spe_hz", "thesis_cell_8spe_hz",
-              "thesis_cell_8spe_efficiency"},
+              "thesis_cell_8spe_efficiency", "sorts_per_step", "kf_sort", "kf_density", "kf_forces", "kf_integrate",
+              "kf_step"},
              8,
              {"particles", "measured_neighbours", "threads", "hz", "us_per_particle_step", "share_hash",
               "share_search_density", "share_forces", "share_integrate", "share_other", "speedup", "efficiency"});
@@ -126,6 +127,7 @@ TEST_F(BenchCli, SphTableQuick) {
   const Csv csv = read_csv(d / "sph-table.csv");
   for (const auto& row : csv.rows) {
     EXPECT_EQ(row[0] == "1000", !row[15].empty()) << row[0];
+    EXPECT_EQ(row[4] != "1", !row[24].empty()) << row[0];  // Karp-Flatt e of the whole step: p > 1 rows only
   }
   expect_records(d / "sph-table.json", "sph-table");
   EXPECT_TRUE(fs::exists(d / "sph-table.md"));

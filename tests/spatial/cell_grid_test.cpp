@@ -16,6 +16,7 @@
 #include "swirl/spatial/brute_force.hpp"
 #include "swirl/spatial/distance.hpp"
 #include "swirl/spatial/reorder_particles.hpp"
+#include "swirl/spatial/skin_tracker.hpp"
 
 namespace {
 
@@ -34,18 +35,11 @@ ParticleSet<Real> random_particles(std::size_t n, double side, std::uint64_t see
   return p;
 }
 
-// Sorts and reorders a copy of p with the grid, then lists every pair the
-// grid's ranges give, as (id_i, id_j) sorted: comparable to brute force on p
-// when p's ids are its indices.
+// Every pair the grid's ranges give for the particles q (in the grid's memory
+// order, possibly moved since the sort), as (id_i, id_j) sorted. Also checks
+// that the ranges are in increasing memory order and do not overlap.
 template <class Real>
-Pairs grid_pairs(const ParticleSet<Real>& p, Real h, std::size_t block_size, bool* dense = nullptr) {
-  spatial::SortedCellGrid<Real> grid;
-  EXPECT_TRUE(grid.sort(p, double(h), block_size));
-  ParticleSet<Real> q = p;
-  spatial::ParticleReorder<Real> reorder;
-  reorder.apply(q, grid.order(), block_size);
-  grid.index(block_size);
-  if (dense) *dense = grid.dense();
+Pairs pairs_of(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& q, Real h) {
   Pairs pairs;
   const Real h2 = h * h;
   spatial::NeighbourRanges ranges{};
@@ -54,6 +48,11 @@ Pairs grid_pairs(const ParticleSet<Real>& p, Real h, std::size_t block_size, boo
       EXPECT_LE(grid.keys()[i - 1], grid.keys()[i]);
     }
     const int count = grid.neighbour_ranges(grid.keys()[i], ranges);
+    EXPECT_LE(count, grid.cell_order() == spatial::CellOrder::Rows ? 9 : 27);
+    // Morton merges ranges that touch; rows keep one range per row.
+    const bool merged = grid.cell_order() == spatial::CellOrder::Morton;
+    for (int r = 1; r < count; ++r)
+      EXPECT_LT(ranges[static_cast<std::size_t>(r - 1)].end, ranges[static_cast<std::size_t>(r)].begin + (merged ? 0 : 1));
     for (int r = 0; r < count; ++r)
       for (std::uint32_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j)
         if (j != i && spatial::within(spatial::distance2(q.position.x[i], q.position.y[i], q.position.z[i],
@@ -65,6 +64,25 @@ Pairs grid_pairs(const ParticleSet<Real>& p, Real h, std::size_t block_size, boo
   return pairs;
 }
 
+// Sorts and reorders a copy of p with the grid, then lists every pair the
+// grid's ranges give: comparable to brute force on p when p's ids are its indices.
+template <class Real>
+Pairs grid_pairs(const ParticleSet<Real>& p, Real h, std::size_t block_size, bool* dense = nullptr,
+                 spatial::CellOrder order = spatial::CellOrder::Rows) {
+  spatial::SortedCellGrid<Real> grid;
+  grid.configure(order, 0);
+  EXPECT_TRUE(grid.sort(p, double(h), block_size));
+  ParticleSet<Real> q = p;
+  spatial::ParticleReorder<Real> reorder;
+  reorder.apply(q, grid.order(), block_size);
+  grid.index(block_size);
+  if (dense) *dense = grid.dense();
+  return pairs_of(grid, q, h);
+}
+
+constexpr spatial::CellOrder kOrders[] = {spatial::CellOrder::Rows, spatial::CellOrder::Morton};
+const char* order_name(spatial::CellOrder o) { return o == spatial::CellOrder::Rows ? "rows" : "morton"; }
+
 template <class Real>
 class CellGridTest : public ::testing::Test {};
 using Precisions = ::testing::Types<float, double>;
@@ -74,10 +92,14 @@ TYPED_TEST(CellGridTest, FindsExactlyTheBruteForcePairsInARandomBox) {
   using Real = TypeParam;
   const auto p = random_particles<Real>(1500, 1.0, 3);
   for (Real h : {Real(0.02), Real(0.09), Real(0.3), Real(2.0)}) {
-    bool dense = false;
-    const Pairs got = grid_pairs(p, h, 64, &dense);
-    EXPECT_EQ(dense, h > Real(0.05));  // 50³ cells for 1500 particles is sparse
-    EXPECT_EQ(got, spatial::brute_force_pairs(p, h)) << "h = " << h;
+    const Pairs expected = spatial::brute_force_pairs(p, h);
+    for (auto order : kOrders) {
+      bool dense = false;
+      const Pairs got = grid_pairs(p, h, 64, &dense, order);
+      // 50³ cells for 1500 particles is sparse (Morton: 2^(3·4) keys for 11³ cells is dense)
+      EXPECT_EQ(dense, h > Real(0.05)) << order_name(order);
+      EXPECT_EQ(got, expected) << "h = " << h << ", " << order_name(order);
+    }
   }
 }
 
@@ -106,20 +128,90 @@ TYPED_TEST(CellGridTest, FindsExactlyTheBruteForcePairsOnCellFacesAndWalls) {
   }
   const Pairs expected = spatial::brute_force_pairs(p, h);
   ASSERT_GT(expected.size(), 1000u);
-  EXPECT_EQ(grid_pairs(p, h, 50), expected);
+  for (auto order : kOrders) EXPECT_EQ(grid_pairs(p, h, 50, nullptr, order), expected) << order_name(order);
 }
 
 // One far particle makes the box too big for a dense table: the sparse lookup
-// (binary search in the sorted keys) must find the same pairs.
+// (the hash table of occupied cells) must find the same pairs.
 TYPED_TEST(CellGridTest, SparseLookupFindsTheSamePairs) {
   using Real = TypeParam;
   auto p = random_particles<Real>(1200, 1.0, 9);
   p.position.x[7] = Real(5000);  // 5000/0.05 = 10^5 cells along x
   const Real h = Real(0.05);
-  bool dense = true;
-  const Pairs got = grid_pairs(p, h, 64, &dense);
-  EXPECT_FALSE(dense);
-  EXPECT_EQ(got, spatial::brute_force_pairs(p, h));
+  const Pairs expected = spatial::brute_force_pairs(p, h);
+  for (auto order : kOrders) {
+    bool dense = true;
+    const Pairs got = grid_pairs(p, h, 64, &dense, order);
+    EXPECT_FALSE(dense);
+    EXPECT_EQ(got, expected) << order_name(order);
+  }
+}
+
+// The hash table of occupied cells against the dense table on the same
+// particles: the same ranges for every cell of the box (occupied or not), with
+// both orders, a dense and a sparse spread, and 1, 2 and 3 threads.
+TYPED_TEST(CellGridTest, HashedTableGivesTheDenseTablesRanges) {
+  using Real = TypeParam;
+  const int before = parallel::thread_count();
+  for (double far : {0.0, 6.0})  // 6: one particle 120 cells away along x
+    for (auto order : kOrders) {
+      auto p = random_particles<Real>(3000, 1.0, 51);
+      if (far > 0) p.position.x[11] = Real(far);
+      const double h = 0.05;
+      spatial::SortedCellGrid<Real> dense;
+      dense.configure(order, 0);
+      dense.set_table(spatial::CellTable::Dense);
+      ASSERT_TRUE(dense.sort(p, h, 128));
+      auto q = p;
+      spatial::ParticleReorder<Real> reorder;
+      reorder.apply(q, dense.order(), 128);
+      dense.index(128);
+      ASSERT_TRUE(dense.dense());
+      const auto dims = dense.dims();
+      for (int threads : {1, 2, 3}) {
+        parallel::set_thread_count(threads);
+        spatial::SortedCellGrid<Real> hashed;
+        hashed.configure(order, 0);
+        hashed.set_table(spatial::CellTable::Hashed);
+        ASSERT_TRUE(hashed.sort(p, h, 128));
+        hashed.index(128);
+        ASSERT_FALSE(hashed.dense());
+        ASSERT_TRUE(std::equal(hashed.order().begin(), hashed.order().end(), dense.order().begin()));
+        spatial::NeighbourRanges a{}, b{};
+        std::size_t compared = 0;
+        // Every cell of the box (an empty cell's neighbours may not be).
+        for (std::uint64_t z = 0; z < dims[2]; ++z)
+          for (std::uint64_t y = 0; y < dims[1]; ++y)
+            for (std::uint64_t x = 0; x < dims[0]; x += (far > 0 ? 3 : 1)) {
+              const std::uint64_t key = order == spatial::CellOrder::Rows ? (z * dims[1] + y) * dims[0] + x
+                                                                          : spatial::morton_key(x, y, z);
+              const int na = dense.neighbour_ranges(key, a), nb = hashed.neighbour_ranges(key, b);
+              ASSERT_EQ(na, nb) << "cell " << x << " " << y << " " << z;
+              for (int r = 0; r < na; ++r) {
+                ASSERT_EQ(a[static_cast<std::size_t>(r)].begin, b[static_cast<std::size_t>(r)].begin);
+                ASSERT_EQ(a[static_cast<std::size_t>(r)].end, b[static_cast<std::size_t>(r)].end);
+              }
+              ++compared;
+            }
+        EXPECT_GT(compared, 1000u);
+        for (std::uint32_t i = 0; i < q.size(); ++i) ASSERT_EQ(dense.cell_end(i), hashed.cell_end(i)) << i;
+      }
+      parallel::set_thread_count(before);
+    }
+}
+
+TYPED_TEST(CellGridTest, RefusesADenseTableBeyondItsLimit) {
+  using Real = TypeParam;
+  auto p = random_particles<Real>(100, 1.0, 1);
+  p.position.x[5] = Real(2000);
+  p.position.y[6] = Real(2000);
+  p.position.z[7] = Real(2000);  // 2·10^6 cells per axis
+  spatial::SortedCellGrid<Real> grid;
+  grid.set_table(spatial::CellTable::Dense);
+  EXPECT_THROW(grid.sort(p, 0.001, 16), std::invalid_argument);
+  grid.set_table(spatial::CellTable::Auto);
+  EXPECT_TRUE(grid.sort(p, 0.001, 16));
+  EXPECT_FALSE(grid.dense());
 }
 
 TYPED_TEST(CellGridTest, RefusesParticlesSpreadOverMoreThanTheKeyRange) {
@@ -176,19 +268,180 @@ TYPED_TEST(CellGridTest, ReorderMovesEveryFieldAndKeepsIds) {
 TYPED_TEST(CellGridTest, OrderIsTheSameForOneTwoAndThreeThreads) {
   using Real = TypeParam;
   const auto p = random_particles<Real>(40000, 1.0, 23);
-  std::vector<std::uint32_t> first;
   const int before = parallel::thread_count();
-  for (int threads : {1, 2, 3}) {
-    parallel::set_thread_count(threads);
-    spatial::SortedCellGrid<Real> grid;
-    ASSERT_TRUE(grid.sort(p, 0.03, 256));
-    std::vector<std::uint32_t> order(grid.order().begin(), grid.order().end());
-    if (first.empty())
-      first = order;
-    else
-      EXPECT_EQ(order, first) << threads << " threads";
+  for (auto cell_order : kOrders) {
+    std::vector<std::uint32_t> first;
+    for (int threads : {1, 2, 3}) {
+      parallel::set_thread_count(threads);
+      spatial::SortedCellGrid<Real> grid;
+      grid.configure(cell_order, 0.004);
+      ASSERT_TRUE(grid.sort(p, 0.03, 256));
+      std::vector<std::uint32_t> order(grid.order().begin(), grid.order().end());
+      if (first.empty())
+        first = order;
+      else
+        EXPECT_EQ(order, first) << threads << " threads, " << order_name(cell_order);
+    }
   }
   parallel::set_thread_count(before);
+}
+
+TEST(CellOrder, MortonKeysInterleaveTheCoordinateBits) {
+  SplitMix64 rng(4);
+  for (int t = 0; t < 1000; ++t) {
+    const std::uint64_t x = rng.next() & 0x1fffff, y = rng.next() & 0x1fffff, z = rng.next() & 0x1fffff;
+    const std::uint64_t k = spatial::morton_key(x, y, z);
+    // The slow twin: bit by bit.
+    std::uint64_t slow = 0;
+    for (int b = 0; b < 21; ++b)
+      slow |= ((x >> b) & 1) << (3 * b) | ((y >> b) & 1) << (3 * b + 1) | ((z >> b) & 1) << (3 * b + 2);
+    ASSERT_EQ(k, slow);
+    EXPECT_EQ(spatial::morton_compact(k), x);
+    EXPECT_EQ(spatial::morton_compact(k >> 1), y);
+    EXPECT_EQ(spatial::morton_compact(k >> 2), z);
+  }
+}
+
+// Morton order in a long thin box: the key space (2^(3·bits of the longest
+// axis)) is far larger than the cells, so the lookup is sparse, and cells at
+// the far end of short axes are clipped.
+TYPED_TEST(CellGridTest, MortonFindsTheBruteForcePairsInAThinBox) {
+  using Real = TypeParam;
+  auto p = random_particles<Real>(3000, 1.0, 31);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.position.x[i] *= Real(6);
+    p.position.z[i] *= Real(0.1);
+  }
+  const Real h = Real(0.07);
+  const Pairs expected = spatial::brute_force_pairs(p, h);
+  ASSERT_GT(expected.size(), 3000u);
+  for (auto order : kOrders) EXPECT_EQ(grid_pairs(p, h, 128, nullptr, order), expected) << order_name(order);
+}
+
+// The Verlet skin: particles drift a random walk for many steps; the grid is
+// sorted only when the tracker asks, and scanning its (stale) ranges must
+// still find exactly the brute-force pairs of the current positions every step.
+TYPED_TEST(CellGridTest, SkinFindsTheBruteForcePairsEveryStepWhileParticlesMove) {
+  using Real = TypeParam;
+  const Real h = Real(0.08);
+  for (auto order : kOrders)
+    for (double skin : {0.25 * h}) {
+      auto q = random_particles<Real>(700, 1.0, 41);
+      // Velocities: most slow, a few fast (up to ~0.1 skin per step), so that
+      // about one step in six needs a sort.
+      SplitMix64 rng(43);
+      for (std::size_t i = 0; i < q.size(); ++i) {
+        const double speed = (i % 61 == 0 ? 0.06 : 0.01) * skin;
+        for (int a = 0; a < 3; ++a) q.velocity[a][i] = Real(speed * (2 * rng.uniform() - 1));
+      }
+      spatial::SortedCellGrid<Real> grid;
+      spatial::ParticleReorder<Real> reorder;
+      spatial::SkinTracker<Real> tracker;
+      int sorts = 0;
+      const int steps = 40;
+      for (int step = 0; step < steps; ++step) {
+        if (tracker.must_resort(q, skin, 64)) {
+          grid.configure(order, skin);
+          ASSERT_TRUE(grid.sort(q, double(h), 64));
+          reorder.apply(q, grid.order(), 64);
+          grid.index(64);
+          tracker.remember(q, 64);
+          ++sorts;
+        }
+        // Brute force on a copy indexed by id.
+        ParticleSet<Real> by_id(q.size());
+        for (std::size_t i = 0; i < q.size(); ++i) {
+          by_id.position.set(q.id[i], q.position.get(i));
+          by_id.id[q.id[i]] = q.id[i];
+        }
+        ASSERT_EQ(pairs_of(grid, q, h), spatial::brute_force_pairs(by_id, h))
+            << "step " << step << ", skin " << skin << ", " << order_name(order);
+        for (std::size_t i = 0; i < q.size(); ++i)  // drift; bounce off the unit box's walls
+          for (int a = 0; a < 3; ++a) {
+            Real& x = q.position[a][i];
+            x += q.velocity[a][i];
+            if (x < Real(0) || x > Real(1)) {
+              q.velocity[a][i] = -q.velocity[a][i];
+              x = std::clamp(x, Real(0), Real(1));
+            }
+          }
+      }
+      EXPECT_GT(sorts, 2) << skin;      // the fast particles force sorts
+      EXPECT_LT(sorts, steps / 2) << skin;  // ... but most steps reuse the grid
+    }
+}
+
+// The worst case of the skin: two particles two cells apart at the sort
+// (just over one cell length h + skin between them) run head-on at each other.
+// They become neighbours only after each moved about skin/2, so the tracker
+// must ask for a sort just in time; a tracker that waited longer would miss the pair.
+TYPED_TEST(CellGridTest, SkinCatchesTwoParticlesRunningHeadOn) {
+  using Real = TypeParam;
+  const double h = 0.1, skin = 0.02;
+  for (auto order : kOrders) {
+    spatial::SortedCellGrid<Real> grid;
+    grid.configure(order, skin);
+    ParticleSet<Real> q(3);
+    for (std::size_t i = 0; i < 3; ++i) q.id[i] = i;
+    ASSERT_TRUE(grid.sort(q, h, 8));
+    const double c = grid.cell_length(), delta = 1e-4;
+    ASSERT_GT(c, h + skin);
+    // An anchor at the origin fixes the cell boundaries at multiples of c.
+    q.position.set(0, Vec3d{0, 0.5, 0.5}.cast<Real>());
+    q.position.set(1, Vec3d{c - delta, 0.5, 0.5}.cast<Real>());
+    q.position.set(2, Vec3d{2 * c + delta, 0.5, 0.5}.cast<Real>());
+    spatial::ParticleReorder<Real> reorder;
+    spatial::SkinTracker<Real> tracker;
+    int sorts = 0, steps_as_neighbours = 0;
+    for (int step = 0; step < 40; ++step) {
+      if (tracker.must_resort(q, skin, 8)) {
+        ASSERT_TRUE(grid.sort(q, h, 8));
+        reorder.apply(q, grid.order(), 8);
+        grid.index(8);
+        tracker.remember(q, 8);
+        ++sorts;
+      }
+      ParticleSet<Real> by_id(q.size());
+      for (std::size_t i = 0; i < q.size(); ++i) {
+        by_id.position.set(q.id[i], q.position.get(i));
+        by_id.id[q.id[i]] = q.id[i];
+      }
+      const Pairs expected = spatial::brute_force_pairs(by_id, Real(h));
+      steps_as_neighbours += expected.size() > 0;
+      ASSERT_EQ(pairs_of(grid, q, Real(h)), expected) << "step " << step << ", " << order_name(order);
+      for (std::size_t i = 0; i < q.size(); ++i) {  // ids 1 and 2 approach by 0.1 skin each per step
+        if (q.id[i] == 1) q.position.x[i] += Real(0.1 * skin);
+        if (q.id[i] == 2) q.position.x[i] -= Real(0.1 * skin);
+      }
+    }
+    EXPECT_GT(steps_as_neighbours, 0);
+    EXPECT_GE(sorts, 2);
+  }
+}
+
+TYPED_TEST(CellGridTest, SkinTrackerAsksForASortWhenTheParticlesChange) {
+  using Real = TypeParam;
+  auto p = random_particles<Real>(500, 1.0, 7);
+  spatial::SkinTracker<Real> tracker;
+  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));  // nothing remembered
+  tracker.remember(p, 32);
+  EXPECT_FALSE(tracker.must_resort(p, 0.1, 32));
+  p.position.y[123] += Real(0.049);
+  EXPECT_FALSE(tracker.must_resort(p, 0.1, 32));
+  p.position.y[123] += Real(0.002);  // 0.051 > skin/2
+  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
+  p.position.y[123] -= Real(0.051);
+  std::swap(p.id[3], p.id[4]);  // someone else reordered
+  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
+  std::swap(p.id[3], p.id[4]);
+  EXPECT_FALSE(tracker.must_resort(p, 0.1, 32));
+  p.position.x[9] = std::numeric_limits<Real>::quiet_NaN();
+  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
+  p.resize(499);
+  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
+  tracker.remember(p, 32);
+  tracker.forget();
+  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
 }
 
 }  // namespace

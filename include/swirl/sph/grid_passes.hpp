@@ -6,18 +6,24 @@
 //                   (eq. 2.10) forces of sph_fluid.hpp.
 //
 // Both walk the particles in memory (= cell) order; the particles of one cell
-// share its 9 neighbour ranges, which are scanned whole: every candidate j is
-// distance-tested and masked with spatial::within(), so the pairs are exactly
-// the hash's. Two implementations of each pass, selected by `Simd`:
-//  - Simd = true: explicit SIMD with xsimd (the widest batch the build's
-//    target has: 16 floats with AVX-512, 4 with the portable x86-64 SSE2), a
-//    batch of candidates per iteration, lanes past the range masked;
+// share its neighbour ranges (spatial::NeighbourRanges), which are scanned
+// whole: every candidate j is distance-tested and masked with
+// spatial::within(), so the pairs are exactly the hash's (to the rounding of
+// r² where the AVX2/AVX-512 copies fuse it into FMAs: a pair within one ulp of
+// h² may fall either way). Two implementations of each pass, selected by `Simd`:
+//  - Simd = true: explicit SIMD with xsimd, a batch of candidates per
+//    iteration, lanes past the range masked. The cell bodies are compiled once
+//    per instruction set (src/sph/grid_passes_simd.cpp, sph/grid_pass_kernels.hpp)
+//    and the width is chosen at run time, not by the build's flags: the widest
+//    the CPU runs (16 floats with AVX-512, 8 with AVX2 + FMA, 4 with SSE2), or
+//    the one SWIRL_SIMD names (core/simd_dispatch.hpp);
 //  - Simd = false: the scalar twin (the same formulas one pair at a time), the
 //    reference the SIMD path is tested against and the "without vectorisation"
 //    of the benchmark.
 // Each particle's sums are gathered into its own entries in a fixed order that
 // depends only on positions and memory order: bit-identical for any thread
-// count (not between Simd and scalar: the summation order differs).
+// count within one instruction set (not between instruction sets, nor between
+// Simd and scalar: the summation order differs).
 // Units as in sph_fluid.hpp (SI).
 #pragma once
 
@@ -26,23 +32,15 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <type_traits>
 #include <vector>
 
-#include <xsimd/xsimd.hpp>
-
 #include "swirl/core/particle_set.hpp"
+#include "swirl/core/simd_dispatch.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/cell_grid.hpp"
 #include "swirl/spatial/distance.hpp"
+#include "swirl/sph/grid_pass_kernels.hpp"
 #include "swirl/sph/kernels.hpp"
-
-// GCC 12 reports the deliberately undefined pass-through operand of the
-// AVX-512 intrinsics xsimd calls (_mm512_undefined_ps) as maybe-uninitialized
-// (and uninitialized) where they are inlined into this file: a known false positive.
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#pragma GCC diagnostic ignored "-Wuninitialized"
 
 namespace swirl::sph {
 
@@ -64,66 +62,37 @@ struct GridScratch {
 
 namespace detail {
 
-// Runs body(i, ranges, count) for every particle of [b, e), grouped by cell so
-// that a cell's ranges are found once.
+// Runs body(first, last, ranges, count) for every cell's particles
+// [first, last) within [b, e), with the cell's neighbour ranges.
 template <class Real, class Body>
-void for_each_in_cells(const spatial::SortedCellGrid<Real>& grid, std::size_t b, std::size_t e, Body&& body) {
+void for_each_cell(const spatial::SortedCellGrid<Real>& grid, std::size_t b, std::size_t e, Body&& body) {
   spatial::NeighbourRanges ranges{};
   std::size_t i = b;
   while (i < e) {
     const std::size_t cell_end = std::min<std::size_t>(e, grid.cell_end(static_cast<std::uint32_t>(i)));
     const int count = grid.neighbour_ranges(grid.keys()[i], ranges);
-    for (; i < cell_end; ++i) body(i, ranges, count);
+    body(i, cell_end, ranges, count);
+    i = cell_end;
   }
 }
 
-template <class Real>
-struct Lanes {
-  using Batch = xsimd::batch<Real>;
-  static constexpr std::size_t W = Batch::size;
-  // iota[k] = k: the lane numbers, for masking lanes past a range's end.
-  static Batch iota() {
-    alignas(64) std::array<Real, W> v{};
-    for (std::size_t k = 0; k < W; ++k) v[k] = Real(k);
-    return Batch::load_aligned(v.data());
+// Runs body(i, ranges, count) for every particle of [b, e), grouped by cell so
+// that a cell's ranges are found once.
+template <class Real, class Body>
+void for_each_in_cells(const spatial::SortedCellGrid<Real>& grid, std::size_t b, std::size_t e, Body&& body) {
+  for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const spatial::NeighbourRanges& ranges, int count) {
+    for (std::size_t i = first; i < last; ++i) body(i, ranges, count);
+  });
+}
+
+// The grid's ranges as the SIMD kernels take them.
+struct KernelRanges {
+  std::array<CandidateRange, spatial::kMaxNeighbourRanges> ranges{};
+  KernelRanges(const spatial::NeighbourRanges& from, int count) {
+    for (std::size_t r = 0; r < static_cast<std::size_t>(count); ++r) ranges[r] = {from[r].begin, from[r].end};
   }
+  const CandidateRange* data() const { return ranges.data(); }
 };
-
-// 1/√x for x > 0. For float: the hardware estimate (rsqrt14 with AVX-512, 12
-// bits below) and one Newton step, relative error ≤ ~2⁻²² — below the float
-// rounding of the sums it enters, and 2–3× cheaper than a square root and a
-// division; elsewhere exact to rounding.
-template <class Batch>
-inline Batch inverse_sqrt(const Batch& x) {
-  using T = typename Batch::value_type;
-  if constexpr (std::is_same_v<T, float>) {
-    Batch y;
-    if constexpr (Batch::size == 16) {
-#if defined(__AVX512F__)
-      y = Batch(_mm512_rsqrt14_ps(x));
-#else
-      return Batch(T(1)) / xsimd::sqrt(x);
-#endif
-    } else if constexpr (Batch::size == 8) {
-#if defined(__AVX__)
-      y = Batch(_mm256_rsqrt_ps(x));
-#else
-      return Batch(T(1)) / xsimd::sqrt(x);
-#endif
-    } else if constexpr (Batch::size == 4) {
-#if defined(__SSE__)
-      y = Batch(_mm_rsqrt_ps(x));
-#else
-      return Batch(T(1)) / xsimd::sqrt(x);
-#endif
-    } else {
-      return Batch(T(1)) / xsimd::sqrt(x);
-    }
-    return y * (Batch(T(1.5)) - Batch(T(0.5)) * x * y * y);
-  } else {
-    return Batch(T(1)) / xsimd::sqrt(x);
-  }
-}
 
 }  // namespace detail
 
@@ -140,43 +109,31 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
   const Real h2 = w.h2;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real *rho = p.density.data(), *pr = p.pressure.data();
-  return parallel::reduce_blocks(
-      "sph_grid_density", n, block_size, std::uint64_t{0},
-      [&](std::size_t b, std::size_t e) {
-        std::uint64_t pairs = 0;
-        detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
-          Real sum = 0;
-          std::uint64_t found = 0;
-          if constexpr (Simd) {
-            using L = detail::Lanes<Real>;
-            using B = typename L::Batch;
-            const B iota = L::iota(), xi(x[i]), yi(y[i]), zi(z[i]), hh(h2), zero(Real(0)), one(Real(1));
-            B acc(Real(0)), hits(Real(0));
-            Real tail = 0;
-            for (int r = 0; r < count; ++r) {
-              std::size_t j = ranges[static_cast<std::size_t>(r)].begin;
-              const std::size_t end = ranges[static_cast<std::size_t>(r)].end;
-              for (; j < end && j + L::W <= n; j += L::W) {
-                const B dx = xi - B::load_unaligned(x + j), dy = yi - B::load_unaligned(y + j),
-                        dz = zi - B::load_unaligned(z + j);
-                const B r2 = dx * dx + dy * dy + dz * dz;
-                const auto in = (r2 < hh) & (iota < B(Real(std::min(end - j, L::W))));
-                const B d = hh - r2;
-                acc += xsimd::select(in, B::load_unaligned(m + j) * d * d * d, zero);
-                hits += xsimd::select(in, one, zero);
-              }
-              for (; j < end; ++j) {  // the last particles of the array: no full batch to load
-                const Real r2 = spatial::distance2(x[i], y[i], z[i], x[j], y[j], z[j]);
-                if (spatial::within(r2, h2)) {
-                  const Real d = h2 - r2;
-                  tail += m[j] * d * d * d;
-                  ++found;
-                }
-              }
-            }
-            sum = xsimd::hadd(acc) + tail;
-            found += static_cast<std::uint64_t>(xsimd::hadd(hits));
-          } else {
+  const auto sum_blocks = [](std::uint64_t a, std::uint64_t b) { return a + b; };
+  if constexpr (Simd) {
+    simd::active();  // a bad SWIRL_SIMD throws here, not inside the parallel region
+    DensityKernelArgs<Real> a;
+    a.x = x, a.y = y, a.z = z, a.mass = m, a.density = rho, a.pressure = pr;
+    a.volume = volume, a.pressure_volume = pressure_volume, a.n = n;
+    a.h2 = h2, a.poly6_norm = w.norm, a.rest_density = k.rest_density, a.c2 = k.c2, a.pressure_floor = k.pressure_floor;
+    return parallel::reduce_blocks(
+        "sph_grid_density", n, block_size, std::uint64_t{0},
+        [&](std::size_t b, std::size_t e) {
+          std::uint64_t pairs = 0;
+          detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
+            pairs += density_cell_simd(a, first, last, detail::KernelRanges(ranges, count).data(), count);
+          });
+          return pairs;
+        },
+        sum_blocks);
+  } else {
+    return parallel::reduce_blocks(
+        "sph_grid_density", n, block_size, std::uint64_t{0},
+        [&](std::size_t b, std::size_t e) {
+          std::uint64_t pairs = 0;
+          detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+            Real sum = 0;
+            std::uint64_t found = 0;
             for (int r = 0; r < count; ++r)
               for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j) {
                 const Real r2 = spatial::distance2(x[i], y[i], z[i], x[j], y[j], z[j]);
@@ -186,17 +143,17 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
                   ++found;
                 }
               }
-          }
-          const Real density = w.norm * sum;
-          rho[i] = density;
-          pr[i] = std::max(k.pressure_floor, k.c2 * (density - k.rest_density));
-          volume[i] = m[i] / density;
-          pressure_volume[i] = pr[i] * volume[i];
-          pairs += found - 1;  // the particle itself is in its own cell's range
-        });
-        return pairs;
-      },
-      [](std::uint64_t a, std::uint64_t b) { return a + b; });
+            const Real density = w.norm * sum;
+            rho[i] = density;
+            pr[i] = std::max(k.pressure_floor, k.c2 * (density - k.rest_density));
+            volume[i] = m[i] / density;
+            pressure_volume[i] = pr[i] * volume[i];
+            pairs += found - 1;  // the particle itself is in its own cell's range
+          });
+          return pairs;
+        },
+        sum_blocks);
+  }
 }
 
 // Adds the pressure and viscosity accelerations (densities, pressures and the
@@ -218,11 +175,24 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
   const Real *V = scratch.volume.data(), *PV = scratch.pressure_volume.data(), *pr = p.pressure.data();
   const Real* rho = p.density.data();
   Real *ax = p.acceleration.x.data(), *ay = p.acceleration.y.data(), *az = p.acceleration.z.data();
-  // Pressure sums (fp) and viscosity sums (fv) of particle i.
+  if constexpr (Simd) {
+    simd::active();  // a bad SWIRL_SIMD throws here, not inside the parallel region
+    ForceKernelArgs<Real> a;
+    a.x = x, a.y = y, a.z = z, a.vx = vx, a.vy = vy, a.vz = vz;
+    a.volume = V, a.pressure_volume = PV, a.pressure = pr, a.density = rho;
+    a.ax = ax, a.ay = ay, a.az = az, a.n = n;
+    a.h = h, a.h2 = h2, a.pressure_norm = pressure_norm, a.visc_norm = visc_norm;
+    parallel::for_blocks("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
+        forces_cell_simd(a, first, last, detail::KernelRanges(ranges, count).data(), count);
+      });
+    });
+    return;
+  }
+  // The scalar twin: pressure sums (fp) and viscosity sums (fv) of particle i.
   struct Sums {
     Real px = 0, py = 0, pz = 0, vx = 0, vy = 0, vz = 0;
   };
-  // One pair, scalar (the twin, and the SIMD path's array tail).
   auto pair = [&](std::size_t i, std::size_t j, Sums& s) {
     const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
     const Real r2 = dx * dx + dy * dy + dz * dz;
@@ -241,47 +211,9 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
   parallel::for_blocks("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
       Sums s;
-      if constexpr (Simd) {
-        using L = detail::Lanes<Real>;
-        using B = typename L::Batch;
-        const B iota = L::iota(), xi(x[i]), yi(y[i]), zi(z[i]), vxi(vx[i]), vyi(vy[i]), vzi(vz[i]), pri(pr[i]);
-        const B hh(h2), hb(h), zero(Real(0)), one(Real(1));
-        B spx(Real(0)), spy(Real(0)), spz(Real(0)), svx(Real(0)), svy(Real(0)), svz(Real(0));
-        for (int r = 0; r < count; ++r) {
-          std::size_t j = ranges[static_cast<std::size_t>(r)].begin;
-          const std::size_t end = ranges[static_cast<std::size_t>(r)].end;
-          for (; j < end && j + L::W <= n; j += L::W) {
-            const B dx = xi - B::load_unaligned(x + j), dy = yi - B::load_unaligned(y + j),
-                    dz = zi - B::load_unaligned(z + j);
-            const B r2 = dx * dx + dy * dy + dz * dz;
-            const auto in = (r2 < hh) & (iota < B(Real(std::min(end - j, L::W))));
-            const auto apart = r2 > zero;
-            const B inv_r = detail::inverse_sqrt(xsimd::select(apart, r2, one));
-            const B q = xsimd::max(hb - r2 * inv_r, zero);
-            const B Vj = B::load_unaligned(V + j);
-            const B g = xsimd::select(apart & in, q * q * inv_r, zero);
-            const B fp = (pri * Vj + B::load_unaligned(PV + j)) * g;
-            const B fv = xsimd::select(in, Vj * q, zero);
-            spx += fp * dx;
-            spy += fp * dy;
-            spz += fp * dz;
-            svx += fv * (B::load_unaligned(vx + j) - vxi);
-            svy += fv * (B::load_unaligned(vy + j) - vyi);
-            svz += fv * (B::load_unaligned(vz + j) - vzi);
-          }
-          for (; j < end; ++j) pair(i, j, s);
-        }
-        s.px += xsimd::hadd(spx);
-        s.py += xsimd::hadd(spy);
-        s.pz += xsimd::hadd(spz);
-        s.vx += xsimd::hadd(svx);
-        s.vy += xsimd::hadd(svy);
-        s.vz += xsimd::hadd(svz);
-      } else {
-        for (int r = 0; r < count; ++r)
-          for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j)
-            pair(i, j, s);
-      }
+      for (int r = 0; r < count; ++r)
+        for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j)
+          pair(i, j, s);
       const Real inv_rho = Real(1) / rho[i];
       ax[i] += (pressure_norm * s.px + visc_norm * s.vx) * inv_rho;
       ay[i] += (pressure_norm * s.py + visc_norm * s.vy) * inv_rho;
@@ -291,5 +223,3 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
 }
 
 }  // namespace swirl::sph
-
-#pragma GCC diagnostic pop

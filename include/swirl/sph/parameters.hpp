@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "swirl/spatial/cell_order.hpp"
+
 namespace swirl::sph {
 
 // Which symmetrisation of the pressure force (see sph_fluid.hpp: eq. 2.8
@@ -37,6 +39,9 @@ struct SphParameters {
   NegativePressure negative_pressure = NegativePressure::Keep;
   NeighbourSearch neighbour_search = NeighbourSearch::Grid;
   bool simd = true;                // grid: explicit SIMD passes (false: their scalar twin)
+  spatial::CellOrder cell_order = spatial::CellOrder::Rows;  // grid: cell order (spatial/cell_order.hpp)
+  double grid_skin = 0;            // grid: Verlet skin, m (≥ 0); 0 = sort every evaluation
+  spatial::CellTable cell_table = spatial::CellTable::Auto;  // grid: dense or hashed cell lookup
 };
 
 // The thesis's table size for n particles: 1.6·n, odd (24001 for 15000).

@@ -5,8 +5,11 @@
 //    moved into that order (ids travel along, so storage order changes from
 //    step to step; use id to follow a particle)                  ("forces.sort")
 //    then density and pressure, then the forces, each computed on the fly over
-//    the 27 cells (9 contiguous ranges) around each particle, with explicit
+//    the 27 cells (9 contiguous ranges in row order, up to 27 in Morton order:
+//    sph.grid.cell_order) around each particle, with explicit
 //    SIMD (sph/grid_passes.hpp)                  ("forces.density", "forces.sph")
+//    With a Verlet skin (sph.grid.skin > 0) the cells are h + skin wide and the
+//    sort is skipped until a particle moved more than skin/2 since the last one.
 //    Particles spread over more than 2^21 cells in an axis fall back to the hash
 //    for that evaluation.
 //  - Hash: the thesis's path, unchanged:
@@ -61,6 +64,7 @@
 #include "swirl/sph/parameters.hpp"
 #include "swirl/spatial/cell_grid.hpp"
 #include "swirl/spatial/reorder_particles.hpp"
+#include "swirl/spatial/skin_tracker.hpp"
 #include "swirl/spatial/spatial_hash.hpp"
 
 namespace swirl::sph {
@@ -93,10 +97,12 @@ class SphFluid final : public ForceModel<Real> {
   const SphParameters& parameters() const { return params_; }
   // True when the last evaluation used the sorted grid (and reordered the particles).
   bool used_grid() const { return used_grid_; }
+  // Grid sorts (and reorders) so far: one per evaluation without a skin.
+  std::uint64_t grid_sorts() const { return grid_sorts_; }
   // Bytes the solver keeps between evaluations (search structures, lists,
   // reorder scratch), in all: add to the particle fields for the memory per particle.
   std::size_t scratch_bytes() const {
-    return grid_.bytes() + reorder_.bytes() + scratch_.bytes() +
+    return grid_.bytes() + reorder_.bytes() + scratch_.bytes() + skin_.bytes() +
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
            lists_.neighbor.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
@@ -110,9 +116,19 @@ class SphFluid final : public ForceModel<Real> {
   bool add_acceleration_grid(ParticleSet<Real>& p, const ForceContext& ctx) {
     {
       PhaseScope phase(ctx, "forces.sort");
-      if (!grid_.sort(p, params_.smoothing_length, ctx.block_size)) return false;
-      reorder_.apply(p, grid_.order(), ctx.block_size);
-      grid_.index(ctx.block_size);
+      // With a skin (sph.grid.skin > 0) the last sort's cells of side h + skin
+      // still hold every neighbour while no particle moved more than skin/2
+      // (spatial/skin_tracker.hpp): the sort and reorder are skipped.
+      const double skin = params_.grid_skin;
+      if (!(skin > 0 && used_grid_ && !skin_.must_resort(p, skin, ctx.block_size))) {
+        grid_.configure(params_.cell_order, skin);
+        grid_.set_table(params_.cell_table);
+        if (!grid_.sort(p, params_.smoothing_length, ctx.block_size)) return false;
+        reorder_.apply(p, grid_.order(), ctx.block_size);
+        grid_.index(ctx.block_size);
+        if (skin > 0) skin_.remember(p, ctx.block_size);
+        ++grid_sorts_;
+      }
     }
     used_grid_ = true;
     lists_ = {};
@@ -222,6 +238,8 @@ class SphFluid final : public ForceModel<Real> {
   spatial::NeighborList<Real> lists_;
   spatial::SortedCellGrid<Real> grid_;
   spatial::ParticleReorder<Real> reorder_;
+  spatial::SkinTracker<Real> skin_;
+  std::uint64_t grid_sorts_ = 0;
   GridScratch<Real> scratch_;
   double mean_neighbors_ = 0;
   bool used_grid_ = false;

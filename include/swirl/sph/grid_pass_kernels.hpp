@@ -1,0 +1,68 @@
+// The explicit-SIMD bodies of the SPH grid passes (sph/grid_passes.hpp), one
+// cell at a time, behind runtime dispatch (core/simd_dispatch.hpp).
+//
+// src/sph/grid_passes_simd.cpp is compiled once per instruction set (SSE2,
+// AVX2 + FMA, AVX-512; `generic` off x86-64); the functions below call the copy
+// of simd::active(): the widest the CPU runs, or SWIRL_SIMD / simd::ScopedIsa.
+// A call handles the particles [first, last) of one cell, which share the
+// `count` candidate ranges of the cells around it; every candidate j is
+// distance-tested (r² < h², lanes past a range masked), so the pairs are
+// exactly the scalar twin's. Arrays are the sorted-order particle fields; the
+// argument structs hold plain pointers and constants (SI units, as in
+// sph_fluid.hpp) so the per-ISA objects need no library header.
+// Within one instruction set a particle's result depends only on the inputs,
+// never on the thread or block that computes it; across instruction sets the
+// summation order (batch width, FMA contraction), and so the last bits, differ.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace swirl::sph {
+
+// A half-open range [begin, end) of candidate indices (sorted order).
+struct CandidateRange {
+  std::uint32_t begin = 0, end = 0;
+};
+
+// Inputs and outputs of the density pass (grid_density()).
+template <class Real>
+struct DensityKernelArgs {
+  const Real *x = nullptr, *y = nullptr, *z = nullptr, *mass = nullptr;
+  Real *density = nullptr, *pressure = nullptr;
+  Real *volume = nullptr, *pressure_volume = nullptr;  // m_i / ρ_i and p_i m_i / ρ_i
+  std::size_t n = 0;                                   // particles (loads stay below n)
+  Real h2 = 1, poly6_norm = 1;                         // ρ = poly6_norm Σ m_j (h² − r²)³
+  Real rest_density = 1000, c2 = 100, pressure_floor = 0;
+};
+
+// Inputs and outputs of the force pass (grid_forces()).
+template <class Real>
+struct ForceKernelArgs {
+  const Real *x = nullptr, *y = nullptr, *z = nullptr;
+  const Real *vx = nullptr, *vy = nullptr, *vz = nullptr;
+  const Real *volume = nullptr, *pressure_volume = nullptr, *pressure = nullptr, *density = nullptr;
+  Real *ax = nullptr, *ay = nullptr, *az = nullptr;  // accumulated into (+=)
+  std::size_t n = 0;
+  Real h = 1, h2 = 1;
+  Real pressure_norm = 0, visc_norm = 0;  // −½ ∇W_spiky norm (or −1×), μ ∇²W_visc norm
+};
+
+// Density and pressure (and the scratch) of particles [first, last); returns
+// their neighbour pairs, self excluded.
+std::uint64_t density_cell_simd(const DensityKernelArgs<float>& a, std::size_t first, std::size_t last,
+                                const CandidateRange* ranges, int count);
+std::uint64_t density_cell_simd(const DensityKernelArgs<double>& a, std::size_t first, std::size_t last,
+                                const CandidateRange* ranges, int count);
+
+// Adds the pressure and viscosity accelerations of particles [first, last).
+void forces_cell_simd(const ForceKernelArgs<float>& a, std::size_t first, std::size_t last,
+                      const CandidateRange* ranges, int count);
+void forces_cell_simd(const ForceKernelArgs<double>& a, std::size_t first, std::size_t last,
+                      const CandidateRange* ranges, int count);
+
+// Lanes of a float batch in the copy the passes now run (simd::active()),
+// asked of that copy: equals simd::float_lanes(simd::active()) on x86-64.
+int grid_pass_float_lanes();
+
+}  // namespace swirl::sph
