@@ -1,13 +1,18 @@
 // `swirl bench bh-scale`: the linear octree (linear_octree.hpp) from 2^12 to
-// 2^23 particles, for each multipole order and opening criterion: time per
-// force evaluation (tree build + walk), the median and 99th-percentile
-// relative force error on a random sample of particles against the direct
-// sum (a full direct sum at 10⁶ particles takes minutes), interactions and
-// nodes per particle, and bytes per particle. Tables via bench.hpp's publish().
+// 2^23 particles, for each multipole order, opening criterion, walk (group or
+// per particle), θ, bucket size, group size and precision: time per force
+// evaluation (tree build + walk), interactions per second of the walk, the
+// median and 99th-percentile relative force error on a random sample of
+// particles against the direct sum in double (a full direct sum at 10⁶
+// particles takes minutes), interactions and nodes per particle, and bytes per
+// particle. Tables via bench.hpp's publish().
 //
-//   swirl bench bh-scale [--sizes 4096,...,8388608] [--threads 2] [--sample 10000] [--opening 0.5]
-//                        [--multipoles monopole,quadrupole] [--criteria paper,barnes] [--bucket 16]
-//                        [--repeats N] [--precision double|float] [--out DIR] [--quick]
+//   swirl bench bh-scale [--sizes 4096,...,8388608] [--threads 1,2] [--sample 10000] [--opening 0.5,...]
+//                        [--multipoles monopole,quadrupole] [--criteria paper,barnes] [--walks group,particle]
+//                        [--bucket 16,...] [--group-sizes 64,...] [--repeats N] [--precision double,float]
+//                        [--out DIR] [--quick]
+//
+// Every list is a dimension of the table; the group size applies to the group walk only.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,13 +40,15 @@ namespace {
 struct BhScaleArgs {
   std::vector<std::size_t> sizes;  // default 2^12 .. 2^23
   std::size_t sample = 10000;
-  double opening = 0.5;
+  std::vector<double> openings{0.5};
   double softening = 0.01;
   std::vector<std::string> multipoles{"monopole", "quadrupole"};
   std::vector<std::string> criteria{"paper", "barnes"};
-  std::size_t bucket = 16;
+  std::vector<std::string> walks{"group"};
+  std::vector<std::size_t> buckets{16};
+  std::vector<std::size_t> group_sizes{gravity::GravitySettings{}.group_size};
   int repeats = 0;  // 0: 3 below 2^19 particles, else 1
-  std::string precision = "double";
+  std::vector<std::string> precisions{"double"};
   std::uint64_t seed = 1;
 };
 
@@ -112,18 +119,41 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
     parallel::set_thread_count(all);
     const auto reference = direct_at(p, at, a.softening);
     const int repeats = a.repeats > 0 ? a.repeats : (n < (std::size_t(1) << 19) ? 3 : 1);
-    for (const auto& mp : a.multipoles) {
-      for (const auto& cr : a.criteria) {
+    const std::string precision = sizeof(Real) == sizeof(float) ? "float" : "double";
+    struct Point {
+      std::string mp, cr, walk;
+      double opening;
+      std::size_t bucket, group;  // group 0: the per-particle walk
+    };
+    std::vector<Point> points;
+    for (const auto& mp : a.multipoles)
+      for (const auto& cr : a.criteria)
+        for (const auto& wk : a.walks)
+          for (double opening : a.openings)
+            for (std::size_t bucket : a.buckets) {
+              if (wk == "particle") {
+                points.push_back({mp, cr, wk, opening, bucket, 0});
+                continue;
+              }
+              for (std::size_t group : a.group_sizes) points.push_back({mp, cr, wk, opening, bucket, group});
+            }
+    for (const Point& pt : points) {
+      {
+        const auto& mp = pt.mp;
+        const auto& cr = pt.cr;
         gravity::GravitySettings g;
         g.scheme = gravity::Scheme::global;
         g.tree = gravity::Tree::linear;
         g.multipole = gravity::parse_multipole(mp);
         g.criterion = gravity::parse_criterion(cr);
-        g.opening = a.opening;
+        g.walk = gravity::parse_walk(pt.walk);
+        g.opening = pt.opening;
         g.softening = a.softening;
-        g.bucket_size = a.bucket;
+        g.bucket_size = pt.bucket;
+        if (pt.group) g.group_size = pt.group;
         for (int th : threads) {
-          bench::progress(fmt::format("bh-scale: N = {}, {}, {}, {} threads", n, mp, cr, th));
+          bench::progress(fmt::format("bh-scale: N = {}, {}, {}, {} walk, theta {}, bucket {}, group {}, {}, {} threads",
+                                      n, mp, cr, pt.walk, pt.opening, pt.bucket, pt.group, precision, th));
           parallel::set_thread_count(th);
           gravity::BarnesHut<Real> tree(g);
           gravity::GravityField<Real> field;
@@ -153,10 +183,15 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
           const auto& st = tree.stats();
           const double tree_bpp = double(st.tree_bytes) / double(n);
           const double field_bpp = 4.0 * sizeof(Real);
-          t.add({bench::integer(static_cast<long long>(n)), bench::text(mp), bench::text(cr),
-                 bench::text(mp + "/" + cr), bench::integer(th), bench::integer(repeats),
-                 bench::significant(1e3 * median(total), 4), bench::significant(1e3 * median(build), 4),
-                 bench::significant(1e3 * median(walk), 4), bench::significant(1e9 * median(total) / double(n), 4),
+          const double interactions_per_second = st.mean_interactions * double(n) / median(walk);
+          t.add({bench::integer(static_cast<long long>(n)), bench::text(precision), bench::text(mp), bench::text(cr),
+                 bench::text(pt.walk), bench::number(pt.opening, 2), bench::integer(static_cast<long long>(pt.bucket)),
+                 bench::text(pt.group ? std::to_string(pt.group) : "-"),
+                 bench::text(fmt::format("{}/{}/{}/{}", precision, mp, cr, pt.walk)), bench::integer(th),
+                 bench::integer(repeats), bench::significant(1e3 * median(total), 4),
+                 bench::significant(1e3 * median(build), 4), bench::significant(1e3 * median(walk), 4),
+                 bench::significant(1e9 * median(total) / double(n), 4),
+                 bench::significant(1e-6 * interactions_per_second, 4),
                  bench::significant(err[err.size() / 2], 3),
                  bench::significant(err[std::size_t(0.99 * double(err.size() - 1))], 3),
                  bench::number(st.mean_interactions, 0), bench::number(st.mean_nodes_visited, 0),
@@ -179,16 +214,28 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
   }
   for (const auto& m : a.multipoles) gravity::parse_multipole(m);  // reject unknown names before measuring
   for (const auto& c : a.criteria) gravity::parse_criterion(c);
-  if (a.precision != "double" && a.precision != "float")
-    throw std::invalid_argument(fmt::format("--precision: \"{}\" is neither \"double\" nor \"float\"", a.precision));
+  for (const auto& w : a.walks) gravity::parse_walk(w);
+  for (const auto& p : a.precisions)
+    if (p != "double" && p != "float")
+      throw std::invalid_argument(fmt::format("--precision: \"{}\" is neither \"double\" nor \"float\"", p));
   const auto threads = bench::thread_counts(common);
   const int previous = parallel::thread_count();
   bench::Table t;
-  t.title = fmt::format("Linear octree: time, accuracy and memory against N (θ or λ = {}, bucket {}, {})", a.opening,
-                        a.bucket, a.precision);
+  auto joined = [](const auto& list) {
+    std::string s;
+    for (const auto& v : list) s += fmt::format("{}{}", s.empty() ? "" : ",", v);
+    return s;
+  };
+  t.title = fmt::format("Linear octree: time, accuracy and memory against N (θ or λ = {}, bucket {}, group {}, {})",
+                        joined(a.openings), joined(a.buckets), joined(a.group_sizes), joined(a.precisions));
   t.columns = {{"particles", "N"},
+               {"precision", "precision"},
                {"multipole", "multipole"},
                {"criterion", "criterion"},
+               {"walk", "walk"},
+               {"opening", "θ or λ"},
+               {"bucket", "bucket"},
+               {"group", "group"},
                {"config", "config"},
                {"threads", "threads"},
                {"repeats", "evaluations"},
@@ -196,6 +243,7 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
                {"ms_build", "ms build"},
                {"ms_walk", "ms walk"},
                {"ns_per_particle", "ns / particle"},
+               {"minteractions_per_second", "M interactions / s (walk)"},
                {"error_median", "force error, median"},
                {"error_p99", "force error, 99th pct"},
                {"interactions", "interactions / particle"},
@@ -204,10 +252,12 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
                {"tree_bytes_per_particle", "tree B / particle"},
                {"total_bytes_per_particle", "total B / particle"},
                {"sampled", "sampled"}};
-  if (a.precision == "float")
-    measure<float>(a, threads, t);
-  else
-    measure<double>(a, threads, t);
+  for (const auto& p : a.precisions) {
+    if (p == "float")
+      measure<float>(a, threads, t);
+    else
+      measure<double>(a, threads, t);
+  }
   parallel::set_thread_count(previous);
 
   bench::SuiteReport r;
@@ -216,17 +266,20 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
   std::string sizes;
   for (std::size_t n : a.sizes) sizes += fmt::format("{}{}", sizes.empty() ? "" : ",", n);
   r.parameters = {{"sizes", sizes},
-                  {"opening", fmt::format("{}", a.opening)},
+                  {"opening", joined(a.openings)},
                   {"softening", fmt::format("{}", a.softening)},
-                  {"bucket", fmt::format("{}", a.bucket)},
+                  {"walks", joined(a.walks)},
+                  {"bucket", joined(a.buckets)},
+                  {"group", joined(a.group_sizes)},
                   {"sample", fmt::format("{}", a.sample)},
-                  {"precision", a.precision}};
+                  {"precision", joined(a.precisions)}};
   r.tables = {t};
   r.notes =
       "One force evaluation = tree build (Morton keys, radix sort, nodes from key prefixes, multipoles) + the "
-      "per-particle walk, on a Plummer sphere (Hénon units, ε as given). Force error: |a_tree − a_direct| / "
+      "walk (`group`: one walk per group of at most `group` particles, its interaction list evaluated by the SIMD "
+      "kernels; `particle`: one walk per particle), on a Plummer sphere (Hénon units, ε as given). Force error: |a_tree − a_direct| / "
       "|a_direct| on a random sample of particles against the direct sum in double. Interactions: node expansions "
-      "plus particle pairs per particle. Tree B / particle: the tree's memory (nodes, sorted copies, keys, sort "
+      "plus particle pairs per particle; M interactions / s: all of them over the walk's time. Tree B / particle: the tree's memory (nodes, sorted copies, keys, sort "
       "buffers); total adds the particle fields (ParticleSet) and the field output. `paper` = the paper's rule "
       "l/d < λ, `barnes` = Barnes' rule d > l/θ + δ (docs/gravity.md).";
   bench::PlotPanel time;
@@ -260,14 +313,22 @@ void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands) {
       ->delimiter(',')
       ->check(CLI::PositiveNumber);
   c->add_option("--sample", args->sample, "Particles sampled for the force error")->check(CLI::PositiveNumber);
-  c->add_option("--opening", args->opening, "theta (barnes) or lambda (paper)")->check(CLI::Range(0.0, 1.0));
+  c->add_option("--opening", args->openings, "theta (barnes) or lambda (paper); a list is a dimension")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1.0));
   c->add_option("--softening", args->softening, "epsilon")->check(CLI::NonNegativeNumber);
   c->add_option("--multipoles", args->multipoles, "monopole,quadrupole")->delimiter(',');
   c->add_option("--criteria", args->criteria, "paper,barnes")->delimiter(',');
-  c->add_option("--bucket", args->bucket, "Particles per leaf at most")->check(CLI::PositiveNumber);
+  c->add_option("--walks", args->walks, "group,particle (default group)")->delimiter(',');
+  c->add_option("--bucket", args->buckets, "Particles per leaf at most (a list is a dimension)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
+  c->add_option("--group-sizes", args->group_sizes, "Group walk: particles per group at most (default: GravitySettings, 256)")
+      ->delimiter(',')
+      ->check(CLI::PositiveNumber);
   c->add_option("--repeats", args->repeats, "Timed evaluations per point (default 3 below 2^19, else 1)")
       ->check(CLI::PositiveNumber);
-  c->add_option("--precision", args->precision, "double or float");
+  c->add_option("--precision", args->precisions, "double,float (default double)")->delimiter(',');
   c->add_option("--seed", args->seed, "Seed of the Plummer sphere and the sample");
   c->add_option("--out", common->out, "Output directory for CSV, JSON, markdown and PNG plots (default bench/bh-scale)");
   c->add_flag("--quick", common->quick, "Tiny sizes: checks the pipeline (CI), measures nothing");

@@ -80,6 +80,8 @@ void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, ParticleSet<Rea
   ls.opening = settings_.opening;
   ls.softening = settings_.softening;
   ls.bucket_size = settings_.bucket_size;
+  ls.walk = settings_.walk;
+  ls.group_size = settings_.group_size;
   linear_.build(p, ls, block_size);
   if (reorder) {
     // Physically along the curve: the walk then reads, and the integrator

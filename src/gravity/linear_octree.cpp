@@ -1,13 +1,16 @@
 // The linear octree: keys, sort, nodes from key prefixes level by level,
-// multipoles bottom-up, and the per-particle non-recursive walk.
+// multipoles bottom-up, the per-particle non-recursive walk, and the group
+// walk (interaction lists evaluated by interaction_kernels.hpp).
 #include "swirl/gravity/linear_octree.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
 
+#include "swirl/gravity/interaction_kernels.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::gravity {
@@ -68,12 +71,32 @@ template <class Real>
 void LinearOctree<Real>::build(const ParticleSet<Real>& p, const LinearTreeSettings& settings, std::size_t block_size) {
   if (block_size == 0) throw std::invalid_argument("linear octree: block size must be at least 1");
   if (settings.bucket_size < 1) throw std::invalid_argument("linear octree: bucket size must be at least 1");
+  if (settings.group_size < 1) throw std::invalid_argument("linear octree: group size must be at least 1");
   if (p.size() >= npos) throw std::invalid_argument("linear octree: too many particles for 32-bit indices");
   settings_ = settings;
   block_size_ = block_size;
   make_keys(p, block_size);
   make_nodes();
   make_multipoles();
+  make_groups();
+}
+
+template <class Real>
+void LinearOctree<Real>::make_groups() {
+  const LinearNodes<Real>& t = nodes_;
+  groups_.clear();
+  if (t.size() == 0) return;
+  // Depth first, first child first: the groups come out in curve order.
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t n = stack.back();
+    stack.pop_back();
+    if (t.child_count[n] == 0 || t.end[n] - t.begin[n] <= settings_.group_size) {
+      groups_.push_back(n);
+      continue;
+    }
+    for (std::uint32_t c = t.first_child[n] + t.child_count[n]; c-- > t.first_child[n];) stack.push_back(c);
+  }
 }
 
 template <class Real>
@@ -408,7 +431,152 @@ void LinearOctree<Real>::walk_one(std::size_t s, Accumulator<Real>& acc, WalkCou
 }
 
 template <class Real>
-WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size) const {
+std::uint64_t LinearOctree<Real>::walk_group(std::size_t g, GroupLists& lists) const {
+  const LinearNodes<Real>& t = nodes_;
+  const std::uint32_t group = groups_[g];
+  const std::uint32_t gb = t.begin[group], ge = t.end[group];
+  Real lo[3] = {x_[gb], y_[gb], z_[gb]}, hi[3] = {x_[gb], y_[gb], z_[gb]};
+  for (std::uint32_t s = gb + 1; s < ge; ++s) {
+    lo[0] = std::min(lo[0], x_[s]);
+    lo[1] = std::min(lo[1], y_[s]);
+    lo[2] = std::min(lo[2], z_[s]);
+    hi[0] = std::max(hi[0], x_[s]);
+    hi[1] = std::max(hi[1], y_[s]);
+    hi[2] = std::max(hi[2], z_[s]);
+  }
+  GroupLists& l = lists;
+  for (auto* a : {&l.px, &l.py, &l.pz, &l.pm, &l.cx, &l.cy, &l.cz, &l.cm, &l.cqxx, &l.cqxy, &l.cqxz, &l.cqyy, &l.cqyz})
+    a->clear();
+  auto add_particles = [&](std::uint32_t b, std::uint32_t e) {
+    l.px.insert(l.px.end(), x_.begin() + b, x_.begin() + e);
+    l.py.insert(l.py.end(), y_.begin() + b, y_.begin() + e);
+    l.pz.insert(l.pz.end(), z_.begin() + b, z_.begin() + e);
+    l.pm.insert(l.pm.end(), m_.begin() + b, m_.begin() + e);
+  };
+  add_particles(gb, ge);  // the group's own particles first: self_offset = 0 skips the self pairs
+  l.stack.resize(kStackDepth);
+  std::uint32_t* stack = l.stack.data();
+  std::size_t top = 0;
+  std::uint64_t popped = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const std::uint32_t n = stack[--top];
+    ++popped;
+    if (n == group) continue;  // already in the list
+    const std::uint32_t nb = t.begin[n], ne = t.end[n];
+    bool open = nb <= gb && ge <= ne;  // an ancestor of the group (ranges nest): holds its particles
+    if (!open) {
+      // Distance from the centre of mass to the box, per axis 0 inside the
+      // slab: with the per-particle walk's operations on the nearest coordinate.
+      const Real cx = t.com_x[n], cy = t.com_y[n], cz = t.com_z[n];
+      const Real ex = std::max(std::max(lo[0] - cx, cx - hi[0]), Real(0));
+      const Real ey = std::max(std::max(lo[1] - cy, cy - hi[1]), Real(0));
+      const Real ez = std::max(std::max(lo[2] - cz, cz - hi[2]), Real(0));
+      const Real d2 = ex * ex + ey * ey + ez * ez;
+      if (d2 > t.open2[n]) {
+        l.cx.push_back(cx);
+        l.cy.push_back(cy);
+        l.cz.push_back(cz);
+        l.cm.push_back(t.mass[n]);
+        l.cqxx.push_back(t.qxx[n]);
+        l.cqxy.push_back(t.qxy[n]);
+        l.cqxz.push_back(t.qxz[n]);
+        l.cqyy.push_back(t.qyy[n]);
+        l.cqyz.push_back(t.qyz[n]);
+        continue;
+      }
+      open = t.child_count[n] != 0;
+      if (!open) {
+        add_particles(nb, ne);
+        continue;
+      }
+    }
+    // Reversed, so the first child is visited first.
+    for (std::uint32_t c = t.first_child[n] + t.child_count[n]; c-- > t.first_child[n];) stack[top++] = c;
+  }
+  return popped;
+}
+
+template <class Real>
+WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
+  const LinearNodes<Real>& t = nodes_;
+  const std::size_t n = x_.size(), groups = groups_.size();
+  // Costliest first (dynamic hand-out then balances the tail): the last
+  // evaluation's cost per sorted slot summed over the group — after a rebuild
+  // an estimate, the curve moving little between steps — or, the first time,
+  // the particle count. The order changes only who computes a group, never
+  // its result.
+  std::vector<double> cost(groups);
+  const bool known = slot_cost_.size() == n;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const std::uint32_t b = t.begin[groups_[g]], e = t.end[groups_[g]];
+    cost[g] = known ? std::accumulate(slot_cost_.begin() + b, slot_cost_.begin() + e, 0.0) : double(e - b);
+  }
+  schedule_.resize(groups);
+  std::iota(schedule_.begin(), schedule_.end(), 0u);
+  std::sort(schedule_.begin(), schedule_.end(),
+            [&](std::uint32_t a, std::uint32_t b) { return cost[a] > cost[b] || (cost[a] == cost[b] && a < b); });
+
+  group_counts_.assign(groups, WalkCounts{});
+  lists_.resize(std::size_t(std::max(parallel::thread_count(), 1)));
+  const Real eps2 = Real(settings_.softening * settings_.softening);
+  const bool quadrupole = settings_.multipole == Multipole::quadrupole;
+  const KernelPath path = settings_.simd_kernels ? KernelPath::simd : KernelPath::scalar;
+  parallel::for_blocks("linear_octree_group_walk", groups, 1, [&](std::size_t k, std::size_t, std::size_t) {
+    const std::size_t g = schedule_[k];
+    const auto thread = std::size_t(omp_get_thread_num());
+    if (thread >= lists_.size()) throw std::logic_error("linear octree: more threads than list buffers");
+    GroupLists& l = lists_[thread];
+    const std::uint64_t popped = walk_group(g, l);
+    const std::uint32_t first = t.begin[groups_[g]];
+    const std::size_t count = t.end[groups_[g]] - first;
+    for (auto* a : {&l.ax, &l.ay, &l.az, &l.phi}) a->assign(count, Real(0));
+    const Targets<Real> targets{x_.data() + first, y_.data() + first, z_.data() + first, l.ax.data(),
+                                l.ay.data(),       l.az.data(),       l.phi.data(),      count};
+    SourceParticles<Real> particles{l.px.data(), l.py.data(), l.pz.data(), l.pm.data(), l.px.size()};
+    particles.self_offset = 0;
+    add_particle_field(particles, targets, eps2, path);
+    if (!l.cx.empty()) {
+      const SourceCells<Real> cells{l.cx.data(),   l.cy.data(),   l.cz.data(),   l.cm.data(),   l.cqxx.data(),
+                                    l.cqxy.data(), l.cqxz.data(), l.cqyy.data(), l.cqyz.data(), l.cx.size()};
+      add_cell_field(cells, targets, eps2, quadrupole, path);
+    }
+    for (std::size_t k2 = 0; k2 < count; ++k2) {
+      const std::uint32_t i = order_[first + k2];
+      out.acceleration.x[i] = l.ax[k2];
+      out.acceleration.y[i] = l.ay[k2];
+      out.acceleration.z[i] = l.az[k2];
+      out.potential[i] = l.phi[k2];
+    }
+    group_counts_[g] = WalkCounts{popped, std::uint64_t(count) * l.cx.size(),
+                                  std::uint64_t(count) * (l.px.size() - 1)};
+  });
+
+  WalkCounts total;
+  slot_cost_.resize(n);
+  const double cell_flops = quadrupole ? kQuadrupoleFlops : kMonopoleFlops;
+  for (std::size_t g = 0; g < groups; ++g) {
+    const WalkCounts& c = group_counts_[g];
+    total.nodes += c.nodes;
+    total.multipoles += c.multipoles;
+    total.pairs += c.pairs;
+    // In flops of the kernels, plus a guess of ~20 per node visited.
+    const std::uint32_t b = t.begin[groups_[g]], e = t.end[groups_[g]];
+    const double group_cost = double(c.pairs) * kParticleFlops + double(c.multipoles) * cell_flops + 20.0 * double(c.nodes);
+    std::fill(slot_cost_.begin() + b, slot_cost_.begin() + e, group_cost / double(e - b));
+  }
+  return total;
+}
+
+template <class Real>
+WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size) {
+  out.resize(x_.size());
+  if (settings_.walk == Walk::group) return evaluate_groups(out);
+  return evaluate_particles(out, block_size);
+}
+
+template <class Real>
+WalkCounts LinearOctree<Real>::evaluate_particles(GravityField<Real>& out, std::size_t block_size) const {
   const std::size_t n = x_.size();
   out.resize(n);
   return parallel::reduce_blocks(
@@ -449,6 +617,8 @@ std::size_t LinearOctree<Real>::bytes() const {
   b += t.child_count.capacity() + t.level.capacity() + t.prefix.capacity() * sizeof(std::uint64_t);
   b += (x_.capacity() + y_.capacity() + z_.capacity() + m_.capacity()) * sizeof(Real);
   b += order_.capacity() * sizeof(std::uint32_t) + raw_keys_.capacity() * sizeof(std::uint64_t);
+  b += (groups_.capacity() + schedule_.capacity()) * sizeof(std::uint32_t) + slot_cost_.capacity() * sizeof(double);
+  b += group_counts_.capacity() * sizeof(WalkCounts);
   // The sort's key and order arrays, each with its spare (radix_sort.hpp).
   b += x_.size() * 2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
   return b;

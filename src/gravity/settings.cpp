@@ -19,6 +19,7 @@ constexpr std::array<std::pair<std::string_view, Multipole>, 2> kMultipoles{{
     {"monopole", Multipole::monopole}, {"quadrupole", Multipole::quadrupole}}};
 constexpr std::array<std::pair<std::string_view, Criterion>, 2> kCriteria{{
     {"paper", Criterion::paper}, {"barnes", Criterion::barnes}}};
+constexpr std::array<std::pair<std::string_view, Walk>, 2> kWalks{{{"group", Walk::group}, {"particle", Walk::particle}}};
 
 template <class Enum, std::size_t N>
 Enum parse(std::string_view what, std::string_view name, const std::array<std::pair<std::string_view, Enum>, N>& table) {
@@ -43,6 +44,8 @@ std::string_view to_string(Scheme scheme) { return name_of(scheme, kSchemes); }
 std::string_view to_string(Tree tree) { return name_of(tree, kTrees); }
 std::string_view to_string(Multipole multipole) { return name_of(multipole, kMultipoles); }
 std::string_view to_string(Criterion criterion) { return name_of(criterion, kCriteria); }
+std::string_view to_string(Walk walk) { return name_of(walk, kWalks); }
+Walk parse_walk(std::string_view name) { return parse("walk", name, kWalks); }
 Tree parse_tree(std::string_view name) { return parse("tree", name, kTrees); }
 Multipole parse_multipole(std::string_view name) { return parse("multipole", name, kMultipoles); }
 Criterion parse_criterion(std::string_view name) { return parse("opening criterion", name, kCriteria); }
@@ -59,6 +62,7 @@ void validate(const GravitySettings& s) {
   if (s.subdomain_size < 1) throw std::invalid_argument("gravity subdomain_size must be at least 1 particle");
   if (s.subtree_nodes < 1) throw std::invalid_argument("gravity subtree_nodes must be at least 1 node");
   if (s.bucket_size < 1) throw std::invalid_argument("gravity bucket_size must be at least 1 particle");
+  if (s.group_size < 1) throw std::invalid_argument("gravity group_size must be at least 1 particle");
 }
 
 }  // namespace swirl::gravity

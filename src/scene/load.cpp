@@ -32,10 +32,11 @@ constexpr std::string_view kSections[] = {"simulation", "box",        "forces", 
                                           "particles",  "sph",        "random_box", "nbody"};
 constexpr std::string_view kNbodyKeys[] = {"method",         "scheme",        "opening", "softening",
                                            "subdomain_size", "subtree_nodes", "tree",    "multipole",
-                                           "opening_criterion", "bucket_size"};
+                                           "opening_criterion", "bucket_size", "walk", "group_size"};
 constexpr std::string_view kTrees[] = {"paper", "linear"};                 // the order of gravity::Tree
 constexpr std::string_view kMultipoles[] = {"monopole", "quadrupole"};     // the order of gravity::Multipole
 constexpr std::string_view kCriteria[] = {"paper", "barnes"};              // the order of gravity::Criterion
+constexpr std::string_view kWalks[] = {"group", "particle"};               // the order of gravity::Walk
 constexpr std::string_view kMethods[] = {"direct", "barnes_hut"};            // the order of gravity::Method
 constexpr std::string_view kSchemes[] = {"subdomain", "subtree", "global"};  // the order of gravity::Scheme
 constexpr std::string_view kPlummerKeys[] = {"kind", "count", "seed", "mass_cut", "offset", "velocity"};
@@ -58,7 +59,9 @@ constexpr std::string_view kSphKeys[] = {"smoothing_length", "neighbours", "rest
                                          "viscosity",        "pressure",   "negative_pressure", "hash",
                                          "neighbour_search", "grid"};
 constexpr std::string_view kHashKeys[] = {"buckets", "duplicate_check"};
-constexpr std::string_view kGridKeys[] = {"simd"};
+constexpr std::string_view kGridKeys[] = {"simd", "cell_order", "skin", "table"};
+constexpr std::string_view kCellOrders[] = {"rows", "morton"};  // the order of spatial::CellOrder
+constexpr std::string_view kCellTables[] = {"auto", "dense", "hashed"};  // the order of spatial::CellTable
 constexpr std::string_view kNeighbourSearches[] = {"grid", "hash"};  // the order of sph::NeighbourSearch
 constexpr std::string_view kPressureForms[] = {"thesis", "consistent"};  // the order of sph::PressureForm
 constexpr std::string_view kNegativePressures[] = {"keep", "zero"};      // the order of sph::NegativePressure
@@ -564,6 +567,10 @@ void read_sph(const Table& top, Scene& s) {
   const Table grid = t.table("grid");
   grid.only(kGridKeys);
   p.simd = grid.boolean("simd", true);
+  p.cell_order = static_cast<spatial::CellOrder>(grid.choice("cell_order", kCellOrders, 0, "cell order"));
+  // A skin beyond 1e9 m is a typo (as for h).
+  p.grid_skin = grid.number("skin", 0.0, Range{0, 1e9, false, false});
+  p.cell_table = static_cast<spatial::CellTable>(grid.choice("table", kCellTables, 0, "cell table"));
   const bool has_h = t.find("smoothing_length") != nullptr, has_k = t.find("neighbours") != nullptr;
   if (has_h && has_k) t.fail("neighbours", fmt::format("cannot be given together with {}", t.key("smoothing_length")));
   if (has_h) {
@@ -614,6 +621,10 @@ void read_nbody(const Table& t, Scene& s) {
   if (!linear && g.criterion != gravity::Criterion::paper)
     t.fail("opening_criterion", "the paper's tree uses the paper's rule only (use tree = \"linear\" with scheme = \"global\")");
   g.bucket_size = static_cast<std::size_t>(t.integer("bucket_size", 16, 1, 1 << 20));
+  g.walk = static_cast<gravity::Walk>(t.choice("walk", kWalks, linear ? 0 : 1, "walk"));
+  if (!linear && g.walk != gravity::Walk::particle)
+    t.fail("walk", "the paper's tree walks per particle only (use tree = \"linear\" with scheme = \"global\")");
+  g.group_size = static_cast<std::size_t>(t.integer("group_size", 256, 1, 1 << 20));
   s.nbody = g;
 }
 
@@ -794,8 +805,10 @@ std::string canonical_text(const Scene& s) {
         kPressureForms[static_cast<std::size_t>(s.sph->pressure_form)],
         kNegativePressures[static_cast<std::size_t>(s.sph->negative_pressure)], s.sph->buckets,
         s.sph->duplicate_check);
-    put("neighbour_search = \"{}\"\ngrid = {{ simd = {} }}\n",
-        kNeighbourSearches[static_cast<std::size_t>(s.sph->neighbour_search)], s.sph->simd);
+    put("neighbour_search = \"{}\"\ngrid = {{ simd = {}, cell_order = \"{}\", skin = {:.17g}, table = \"{}\" }}\n",
+        kNeighbourSearches[static_cast<std::size_t>(s.sph->neighbour_search)], s.sph->simd,
+        kCellOrders[static_cast<std::size_t>(s.sph->cell_order)], s.sph->grid_skin,
+        kCellTables[static_cast<std::size_t>(s.sph->cell_table)]);
   }
   if (s.nbody)
     put("[nbody]\nmethod = \"{}\"\nscheme = \"{}\"\nopening = {:.17g}\nsoftening = {:.17g}\nsubdomain_size = {}\n"
@@ -803,9 +816,10 @@ std::string canonical_text(const Scene& s) {
         kMethods[static_cast<std::size_t>(s.nbody->method)], kSchemes[static_cast<std::size_t>(s.nbody->scheme)],
         s.nbody->opening, s.nbody->softening, s.nbody->subdomain_size, s.nbody->subtree_nodes);
   if (s.nbody)
-    put("tree = \"{}\"\nmultipole = \"{}\"\nopening_criterion = \"{}\"\nbucket_size = {}\n",
+    put("tree = \"{}\"\nmultipole = \"{}\"\nopening_criterion = \"{}\"\nbucket_size = {}\nwalk = \"{}\"\ngroup_size = {}\n",
         kTrees[static_cast<std::size_t>(s.nbody->tree)], kMultipoles[static_cast<std::size_t>(s.nbody->multipole)],
-        kCriteria[static_cast<std::size_t>(s.nbody->criterion)], s.nbody->bucket_size);
+        kCriteria[static_cast<std::size_t>(s.nbody->criterion)], s.nbody->bucket_size,
+        kWalks[static_cast<std::size_t>(s.nbody->walk)], s.nbody->group_size);
   if (s.random_box)
     put("[random_box]\nparticles = {}\nneighbours = {:.17g}\nseed = {}\n", s.random_box->particles,
         s.random_box->neighbors, s.random_box->seed);

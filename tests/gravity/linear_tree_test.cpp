@@ -41,6 +41,7 @@ TYPED_TEST_SUITE(LinearTreeTest, testing::Precisions);
 LinearTreeSettings tree_settings(Multipole multipole, Criterion criterion, double opening, double eps,
                                  std::size_t bucket = 16) {
   LinearTreeSettings s;
+  s.walk = Walk::particle;  // these are the per-particle walk's tests; group_walk_test.cpp tests the group walk
   s.multipole = multipole;
   s.criterion = criterion;
   s.opening = opening;

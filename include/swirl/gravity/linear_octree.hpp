@@ -42,6 +42,26 @@
 // must never enter an expansion: a self-interaction, and d can be ~0); θ or
 // λ = 0 opens everything, and the walk is then the direct sum's very terms.
 //
+// Walks (LinearTreeSettings::walk):
+//   particle  one non-recursive walk per particle with the rule above: the
+//             slow twin and reference;
+//   group     one walk per group: a node with at most group_size particles
+//             whose parent has more (or a larger leaf, which is never cut),
+//             groups in curve order. A node is accepted iff it holds no group
+//             particle and d_box² > open2, d_box = the distance from its centre
+//             of mass to the group's bounding box: d_box ≤ d for every particle
+//             of the group, so the test is at least as strict as the
+//             per-particle one (and in floating point too: the box distance is
+//             computed with the same operations on the nearest coordinate).
+//             The walk fills the group's interaction list — cell sources (com,
+//             mass, quadrupole) and particle sources (the particles of opened
+//             leaves, the group's own first, its self pairs skipped) — which
+//             interaction_kernels.hpp evaluates for all the group's particles.
+//             Groups go to threads dynamically, costliest first by the last
+//             evaluation's interaction counts (kept per sorted slot, so they
+//             carry over a rebuild as an estimate); each group's result
+//             depends only on the tree, never on the thread or the order.
+//
 // Units: G = 1; lengths as the positions; side of the root cube = root_side().
 #pragma once
 
@@ -67,6 +87,9 @@ struct LinearTreeSettings {
   double opening = 0.5;    // λ (paper) or θ (barnes), in [0, 1]
   double softening = 0.01;  // ε
   std::size_t bucket_size = 16;
+  Walk walk = Walk::group;
+  std::size_t group_size = 256;  // the group walk's particles per group, at most (unless a leaf holds more)
+  bool simd_kernels = true;     // group walk: false uses the kernels' scalar path (the reference)
 };
 
 // The node arrays (SoA). Index n in every array is node n; node 0 is the root.
@@ -84,7 +107,8 @@ struct LinearNodes {
   std::size_t size() const { return begin.size(); }
 };
 
-// What a walk did, summed over the particles walked.
+// What a walk did, summed over the particles walked (interactions: one source
+// on one particle, whichever walk; nodes: per walk, so per group for the group walk).
 struct WalkCounts {
   std::uint64_t nodes = 0;         // nodes popped from the visit stack
   std::uint64_t multipoles = 0;    // node expansions evaluated
@@ -105,8 +129,15 @@ class LinearOctree {
   // ParticleSet index and sorted slot now coincide, order() becomes the identity.
   void adopt_curve_order();
 
-  // Writes out[order()[s]] for every particle (out resized to the particle count).
-  WalkCounts evaluate(GravityField<Real>& out, std::size_t block_size) const;
+  // Writes out[order()[s]] for every particle (out resized to the particle
+  // count), with settings().walk. Not const: the group walk keeps its
+  // per-thread lists and the groups' costs for the next call.
+  WalkCounts evaluate(GravityField<Real>& out, std::size_t block_size);
+
+  // The group walk's groups (node indices, in curve order), and the order the
+  // last group walk handed them to the threads (indices into groups()).
+  std::span<const std::uint32_t> groups() const { return groups_; }
+  std::span<const std::uint32_t> group_schedule() const { return schedule_; }
 
   const LinearNodes<Real>& nodes() const { return nodes_; }
   std::span<const std::uint32_t> order() const { return order_; }
@@ -131,6 +162,19 @@ class LinearOctree {
   void make_multipoles();
   void walk_one(std::size_t s, Accumulator<Real>& acc, WalkCounts& counts) const;
 
+  // One thread's interaction list and the group's field (reused across groups).
+  struct GroupLists {
+    AlignedVector<Real> px, py, pz, pm;                                   // particle sources
+    AlignedVector<Real> cx, cy, cz, cm, cqxx, cqxy, cqxz, cqyy, cqyz;      // cell sources
+    AlignedVector<Real> ax, ay, az, phi;                                  // the group's field
+    std::vector<std::uint32_t> stack;
+  };
+  void make_groups();
+  WalkCounts evaluate_particles(GravityField<Real>& out, std::size_t block_size) const;
+  WalkCounts evaluate_groups(GravityField<Real>& out);
+  // Fills lists for group g; returns the nodes popped.
+  std::uint64_t walk_group(std::size_t g, GroupLists& lists) const;
+
   LinearTreeSettings settings_;
   LinearNodes<Real> nodes_;
   parallel::RadixSort<std::uint64_t> sorter_;
@@ -141,6 +185,11 @@ class LinearOctree {
   double side_ = 0;
   int depth_ = 0;
   std::size_t block_size_ = 1024;
+  std::vector<std::uint32_t> groups_;    // group walk: the group nodes
+  std::vector<std::uint32_t> schedule_;  // the last walk's order of groups
+  std::vector<double> slot_cost_;        // per sorted slot: its group's last cost / its size
+  std::vector<WalkCounts> group_counts_;
+  std::vector<GroupLists> lists_;        // per thread
 };
 
 extern template class LinearOctree<float>;

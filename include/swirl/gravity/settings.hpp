@@ -42,11 +42,20 @@ enum class Multipole { monopole, quadrupole };
 //           geometric centre| (linear_octree.hpp says which failure each prevents).
 enum class Criterion { paper, barnes };
 
+// How the linear tree is walked:
+//   group     one walk per group of ≤ group_size particles (a leaf or a small
+//             subtree), opening from the node's centre of mass to the group's
+//             bounding box, then the group's interaction list evaluated for all
+//             its particles by the SIMD kernels (interaction_kernels.hpp);
+//   particle  one walk per particle: the group walk's slow twin and reference.
+enum class Walk { group, particle };
+
 std::string_view to_string(Method method);
 std::string_view to_string(Scheme scheme);
 std::string_view to_string(Tree tree);
 std::string_view to_string(Multipole multipole);
 std::string_view to_string(Criterion criterion);
+std::string_view to_string(Walk walk);
 // Parse "direct" | "barnes_hut" and "subdomain" | "subtree" | "global"; an
 // unknown name throws std::invalid_argument listing the allowed ones.
 Method parse_method(std::string_view name);
@@ -55,6 +64,8 @@ Scheme parse_scheme(std::string_view name);
 Tree parse_tree(std::string_view name);
 Multipole parse_multipole(std::string_view name);
 Criterion parse_criterion(std::string_view name);
+// "group" | "particle"; the same errors.
+Walk parse_walk(std::string_view name);
 
 struct GravitySettings {
   Method method = Method::barnes_hut;
@@ -65,6 +76,10 @@ struct GravitySettings {
   // Linear tree: a node with more particles than this is split (measured in
   // docs/performance/gravity-tree.md).
   std::size_t bucket_size = 16;
+  // Linear tree: per-group or per-particle walk, and the group walk's group
+  // size (particles at most, unless one leaf holds more; docs/performance/gravity-tree.md).
+  Walk walk = Walk::group;
+  std::size_t group_size = 256;
   // Linear tree under GravityForce: physically reorder the ParticleSet along
   // the Morton curve at every evaluation (ids survive), so the walk and the
   // integrator stream through memory.
