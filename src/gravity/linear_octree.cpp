@@ -10,6 +10,7 @@
 #include <string_view>
 #include <utility>
 
+#include "swirl/core/morton.hpp"
 #include "swirl/gravity/interaction_kernels.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
@@ -25,27 +26,6 @@ constexpr std::size_t kNodeBlock = 256;
 // The visit stack: each of the ≤ 22 levels leaves at most 7 siblings behind.
 constexpr std::size_t kStackDepth = 8 * (LinearOctree<double>::kLevels + 2);
 
-// Spreads the low 21 bits of v to every third bit.
-constexpr std::uint64_t spread3(std::uint64_t v) {
-  v &= 0x1fffffu;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
-}
-
-// Cell coordinate along one axis from a Morton prefix of `level` digits.
-constexpr std::uint64_t compact3(std::uint64_t v) {
-  v &= 0x1249249249249249ULL;
-  v = (v | v >> 2) & 0x10c30c30c30c30c3ULL;
-  v = (v | v >> 4) & 0x100f00f00f00f00fULL;
-  v = (v | v >> 8) & 0x1f0000ff0000ffULL;
-  v = (v | v >> 16) & 0x1f00000000ffffULL;
-  v = (v | v >> 32) & 0x1fffffULL;
-  return v;
-}
 
 // for_blocks, but a range of one block runs on the calling thread: the top
 // levels of the tree have a handful of nodes, and a parallel region per level
@@ -138,7 +118,7 @@ void LinearOctree<Real>::make_keys(const ParticleSet<Real>& p, std::size_t block
         const double c = std::floor((double(p.position[a][i]) - corner_[std::size_t(a)]) * scale);
         // The far faces map to the last cell.
         const std::uint64_t q = c >= cells ? std::uint64_t(cells - 1) : (c > 0 ? std::uint64_t(c) : 0);
-        key |= spread3(q) << a;
+        key |= morton_spread(q) << a;
       }
       raw_keys_[i] = key;
     }
@@ -266,9 +246,9 @@ void LinearOctree<Real>::make_multipoles() {
       for (std::size_t node = lb + b; node < lb + e; ++node) {
         const double cell = side_ / double(std::uint64_t(1) << t.level[node]);
         const std::uint64_t prefix = t.prefix[node];
-        const double centre[3] = {corner_[0] + (double(compact3(prefix)) + 0.5) * cell,
-                                  corner_[1] + (double(compact3(prefix >> 1)) + 0.5) * cell,
-                                  corner_[2] + (double(compact3(prefix >> 2)) + 0.5) * cell};
+        const double centre[3] = {corner_[0] + (double(morton_compact(prefix)) + 0.5) * cell,
+                                  corner_[1] + (double(morton_compact(prefix >> 1)) + 0.5) * cell,
+                                  corner_[2] + (double(morton_compact(prefix >> 2)) + 0.5) * cell};
         Moments r{};
         if (t.child_count[node] == 0) {
           const std::uint32_t first = t.begin[node], last = t.end[node];
@@ -359,9 +339,9 @@ void LinearOctree<Real>::make_multipoles() {
         radius = cell / opening;
         if (barnes) {
           const std::uint64_t prefix = t.prefix[node];
-          const double dx = corner_[0] + (double(compact3(prefix)) + 0.5) * cell - r.x;
-          const double dy = corner_[1] + (double(compact3(prefix >> 1)) + 0.5) * cell - r.y;
-          const double dz = corner_[2] + (double(compact3(prefix >> 2)) + 0.5) * cell - r.z;
+          const double dx = corner_[0] + (double(morton_compact(prefix)) + 0.5) * cell - r.x;
+          const double dy = corner_[1] + (double(morton_compact(prefix >> 1)) + 0.5) * cell - r.y;
+          const double dz = corner_[2] + (double(morton_compact(prefix >> 2)) + 0.5) * cell - r.z;
           radius += std::sqrt(dx * dx + dy * dy + dz * dz);
         }
       }

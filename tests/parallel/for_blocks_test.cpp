@@ -9,7 +9,9 @@
 namespace {
 
 using swirl::parallel::for_blocks;
+using swirl::parallel::for_blocks_pinned;
 using swirl::parallel::reduce_blocks;
+using swirl::parallel::reduce_blocks_pinned;
 
 TEST(ForBlocks, VisitsEveryIndexExactlyOnceInFixedBlocks) {
   for (int threads : {1, 2, 3}) {
@@ -76,6 +78,44 @@ TEST(ForBlocks, AnExceptionInABlockIsRethrownWithTheKernelName) {
   }
   EXPECT_THROW(for_blocks("k", 10, 0, [](std::size_t, std::size_t, std::size_t) {}), std::invalid_argument);
   EXPECT_THROW(swirl::parallel::set_thread_count(0), std::invalid_argument);
+}
+
+TEST(ForBlocksPinned, VisitsEveryBlockOnceAndGivesEachBlockTheSameThreadEveryCall) {
+  for (int threads : {1, 2, 3}) {
+    swirl::parallel::set_thread_count(threads);
+    const std::size_t n = 1000, size = 7, blocks = swirl::parallel::block_count(n, size);
+    std::vector<int> first(blocks, -1), hits(n, 0);
+    for (int call = 0; call < 5; ++call) {
+      std::vector<int> thread(blocks, -1);
+      for_blocks_pinned("test", n, size, [&](std::size_t b, std::size_t e, std::size_t block) {
+        ASSERT_EQ(b, block * size);
+        for (std::size_t i = b; i < e; ++i) ++hits[i];
+        thread[block] = omp_get_thread_num();
+      });
+      if (call == 0) first = thread;
+      EXPECT_EQ(thread, first) << threads << " threads, call " << call;
+    }
+    for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(hits[i], 5);
+    // Contiguous runs: the thread number never decreases along the blocks.
+    for (std::size_t b = 1; b < blocks; ++b) EXPECT_LE(first[b - 1], first[b]);
+  }
+}
+
+TEST(ReduceBlocksPinned, EqualsTheWorkpoolsFoldBitForBit) {
+  std::vector<double> values(50000);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = std::cos(double(i)) / double(i + 1);
+  const auto block_sum = [&](std::size_t b, std::size_t e) {
+    double s = 0;
+    for (std::size_t i = b; i < e; ++i) s += values[i];
+    return s;
+  };
+  const auto add = [](double x, double y) { return x + y; };
+  swirl::parallel::set_thread_count(1);
+  const double reference = reduce_blocks("sum", values.size(), 61, 0.0, block_sum, add);
+  for (int threads : {1, 2, 3}) {
+    swirl::parallel::set_thread_count(threads);
+    EXPECT_EQ(reduce_blocks_pinned("sum", values.size(), 61, 0.0, block_sum, add), reference) << threads;
+  }
 }
 
 }  // namespace

@@ -20,7 +20,8 @@ class UniformGravity final : public ForceModel<Real> {
     Real* ay = p.acceleration.y.data();
     Real* az = p.acceleration.z.data();
     const Vec3<Real> g = g_;
-    parallel::for_blocks("uniform_gravity", p.size(), ctx.block_size, [=](std::size_t b, std::size_t e, std::size_t) {
+    const std::size_t n = p.size();
+    parallel::for_blocks_pinned("uniform_gravity", n, ctx.block_size, [=](std::size_t b, std::size_t e, std::size_t) {
 #pragma omp simd
       for (std::size_t i = b; i < e; ++i) {
         ax[i] += g.x;

@@ -8,6 +8,15 @@
 // reduce_blocks() keeps that promise for reductions by combining per-block
 // partial results in block order.
 //
+// Blocks go to threads in one of two ways, neither of which changes a result:
+// for_blocks/reduce_blocks are the workpool (a thread takes the next free
+// block: for irregular work such as tree walks); the _pinned variants give
+// thread t the same contiguous run of blocks on every call (OpenMP's static
+// schedule), so a particle is handled by the same core in every pass and,
+// while the particle order is stable, in every step: its data stay in that
+// core's caches. The uniform per-particle passes of the SPH grid and the
+// integrator use them (measured in docs/performance/sph-grid.md).
+//
 // An exception thrown inside a block is caught (OpenMP would terminate the
 // program), the loop finishes, and the first one is rethrown with the kernel's
 // name prepended.
@@ -21,6 +30,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <omp.h>
@@ -63,38 +73,75 @@ class FirstError {
 };
 }  // namespace detail
 
-// Calls body(begin, end, block) for every block [begin, end) of [0, n), in
-// parallel. body must only write data owned by its own block.
+namespace detail {
+enum class Schedule { dynamic, pinned };
+
 template <class Body>
-void for_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
+void run_blocks(Schedule schedule, std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
   if (block_size == 0) throw std::invalid_argument(std::string(kernel) + ": block size must be at least 1");
   const auto blocks = static_cast<std::int64_t>(block_count(n, block_size));
-  detail::FirstError error;
-#pragma omp parallel for schedule(dynamic, 1)
-  for (std::int64_t b = 0; b < blocks; ++b) {
+  FirstError error;
+  const auto run = [&](std::int64_t b) {
     try {
       const std::size_t begin = static_cast<std::size_t>(b) * block_size;
       body(begin, std::min(n, begin + block_size), static_cast<std::size_t>(b));
     } catch (...) {
       error.capture();
     }
+  };
+  if (schedule == Schedule::pinned) {
+#pragma omp parallel for schedule(static)
+    for (std::int64_t b = 0; b < blocks; ++b) run(b);
+  } else {
+#pragma omp parallel for schedule(dynamic, 1)
+    for (std::int64_t b = 0; b < blocks; ++b) run(b);
   }
   error.rethrow(kernel);
+}
+
+template <class T, class BlockResult, class Combine>
+T reduce(Schedule schedule, std::string_view kernel, std::size_t n, std::size_t block_size, T init,
+         BlockResult&& block_result, Combine&& combine) {
+  std::vector<T> partial(block_count(n, block_size), init);
+  run_blocks(schedule, kernel, n, block_size, [&](std::size_t begin, std::size_t end, std::size_t b) {
+    partial[b] = block_result(begin, end);
+  });
+  T total = init;
+  for (const T& p : partial) total = combine(total, p);
+  return total;
+}
+}  // namespace detail
+
+// Calls body(begin, end, block) for every block [begin, end) of [0, n), in
+// parallel, blocks to threads as a workpool. body must only write data owned
+// by its own block.
+template <class Body>
+void for_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
+  detail::run_blocks(detail::Schedule::dynamic, kernel, n, block_size, std::forward<Body>(body));
+}
+
+// for_blocks with every block pinned to the same thread on every call.
+template <class Body>
+void for_blocks_pinned(std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
+  detail::run_blocks(detail::Schedule::pinned, kernel, n, block_size, std::forward<Body>(body));
 }
 
 // Computes partial = block_result(begin, end) for every block in parallel, then
 // folds them in block order: combine(combine(init, p0), p1)... Deterministic
 // for any thread count, also for floating-point sums.
 template <class T, class BlockResult, class Combine>
-T reduce_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, T init,
-                BlockResult&& block_result, Combine&& combine) {
-  std::vector<T> partial(block_count(n, block_size), init);
-  for_blocks(kernel, n, block_size, [&](std::size_t begin, std::size_t end, std::size_t b) {
-    partial[b] = block_result(begin, end);
-  });
-  T total = init;
-  for (const T& p : partial) total = combine(total, p);
-  return total;
+T reduce_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, T init, BlockResult&& block_result,
+                Combine&& combine) {
+  return detail::reduce(detail::Schedule::dynamic, kernel, n, block_size, std::move(init),
+                        std::forward<BlockResult>(block_result), std::forward<Combine>(combine));
+}
+
+// reduce_blocks with every block pinned to the same thread on every call.
+template <class T, class BlockResult, class Combine>
+T reduce_blocks_pinned(std::string_view kernel, std::size_t n, std::size_t block_size, T init,
+                       BlockResult&& block_result, Combine&& combine) {
+  return detail::reduce(detail::Schedule::pinned, kernel, n, block_size, std::move(init),
+                        std::forward<BlockResult>(block_result), std::forward<Combine>(combine));
 }
 
 }  // namespace swirl::parallel

@@ -156,7 +156,7 @@ class Simulation {
     Escape escape;
     {
       ScopedPhase phase(timers_, "integrate");
-      escape = parallel::reduce_blocks(
+      escape = parallel::reduce_blocks_pinned(
           "drift", particles_.size(), settings_.block_size, Escape{},
           [&](std::size_t b, std::size_t e) { return drift_block(b, e, dt, escapes); },
           [](const Escape& x, const Escape& y) { return y.excess > x.excess ? y : x; });
@@ -164,7 +164,7 @@ class Simulation {
     compute_forces_at(t_next);
     {
       ScopedPhase phase(timers_, "integrate");
-      scan_ = parallel::reduce_blocks(
+      scan_ = parallel::reduce_blocks_pinned(
           "kick", particles_.size(), settings_.block_size, sim::StepScan{},
           [&](std::size_t b, std::size_t e) { return kick_block(b, e, dt, checks); }, &sim::StepScan::combine);
       ++step_count_;
@@ -223,7 +223,7 @@ class Simulation {
 
   void compute_forces_at(double t) {
     ScopedPhase phase(timers_, "forces");
-    parallel::for_blocks("zero_acceleration", particles_.size(), settings_.block_size,
+    parallel::for_blocks_pinned("zero_acceleration", particles_.size(), settings_.block_size,
                          [&](std::size_t b, std::size_t e, std::size_t) {
                            for (int axis = 0; axis < 3; ++axis) {
                              Real* a = particles_.acceleration[axis].data();
@@ -240,7 +240,7 @@ class Simulation {
 
   // The scan of the current state outside a step (start, resume).
   void rescan() {
-    scan_ = parallel::reduce_blocks(
+    scan_ = parallel::reduce_blocks_pinned(
         "scan", particles_.size(), settings_.block_size, sim::StepScan{},
         [&](std::size_t b, std::size_t e) { return sim::scan_block(particles_, b, e, wants_density(), wants_bounds()); },
         &sim::StepScan::combine);

@@ -92,7 +92,7 @@ class SortedCellGrid {
     inv_cell_ = 1.0 / cell_;
     if (!bounds(p, block_size)) return false;
     keys_.resize(n);
-    parallel::for_blocks("cell_keys", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    parallel::for_blocks_pinned("cell_keys", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
       for (std::size_t i = b; i < e; ++i) keys_[i] = key_of(coordinate(x[i], 0), coordinate(y[i], 1), coordinate(z[i], 2));
     });
@@ -130,7 +130,7 @@ class SortedCellGrid {
     start_.resize(cells + 1);
     // start_[k] = first sorted index with key ≥ k: particle i writes the
     // entries for the keys in (keys[i−1], keys[i]]; every entry is written once.
-    parallel::for_blocks("cell_table", n_, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    parallel::for_blocks_pinned("cell_table", n_, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       for (std::size_t i = b; i < e; ++i) {
         const std::uint64_t from = i == 0 ? 0 : keys[i - 1] + 1;
         for (std::uint64_t k = from; k <= keys[i]; ++k) start_[k] = static_cast<std::uint32_t>(i);
@@ -232,7 +232,7 @@ class SortedCellGrid {
     using MinMax = std::array<double, 6>;
     constexpr double inf = std::numeric_limits<double>::infinity();
     const MinMax init{inf, inf, inf, -inf, -inf, -inf};
-    const MinMax box = parallel::reduce_blocks(
+    const MinMax box = parallel::reduce_blocks_pinned(
         "cell_bounds", p.size(), block_size, init,
         [&](std::size_t b, std::size_t e) {
           MinMax m = init;

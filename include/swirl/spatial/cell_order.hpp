@@ -20,6 +20,8 @@
 
 #include <cstdint>
 
+#include "swirl/core/morton.hpp"
+
 namespace swirl::spatial {
 
 enum class CellOrder {
@@ -33,33 +35,9 @@ enum class CellTable {
   Hashed,  // always the hash table of occupied cells
 };
 
-// The 21 low bits of v spread to every third bit (bit k → bit 3k).
-constexpr std::uint64_t morton_spread(std::uint64_t v) {
-  v &= 0x1fffffu;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
-}
-
-// The inverse of morton_spread: bits 0, 3, 6, ... of v packed into 21 bits.
-constexpr std::uint64_t morton_compact(std::uint64_t v) {
-  v &= 0x1249249249249249ULL;
-  v = (v ^ (v >> 2)) & 0x10c30c30c30c30c3ULL;
-  v = (v ^ (v >> 4)) & 0x100f00f00f00f00fULL;
-  v = (v ^ (v >> 8)) & 0x1f0000ff0000ffULL;
-  v = (v ^ (v >> 16)) & 0x1f00000000ffffULL;
-  v = (v ^ (v >> 32)) & 0x1fffffULL;
-  return v;
-}
-
-constexpr std::uint64_t morton_key(std::uint64_t cx, std::uint64_t cy, std::uint64_t cz) {
-  return morton_spread(cx) | morton_spread(cy) << 1 | morton_spread(cz) << 2;
-}
-
-static_assert(morton_key(1, 0, 0) == 1 && morton_key(0, 1, 0) == 2 && morton_key(0, 0, 1) == 4);
-static_assert(morton_compact(morton_spread(0x1abcdeu)) == 0x1abcdeu);
+// The Morton key functions live in core/morton.hpp (shared with the octree).
+using swirl::morton_compact;
+using swirl::morton_key;
+using swirl::morton_spread;
 
 }  // namespace swirl::spatial

@@ -36,7 +36,7 @@ class OccupiedCellTable {
   // keys: sorted ascending, each below 2^63.
   void build(std::span<const std::uint64_t> keys, std::size_t block_size) {
     const std::size_t n = keys.size();
-    const std::size_t occupied = parallel::reduce_blocks(
+    const std::size_t occupied = parallel::reduce_blocks_pinned(
         "cell_hash_count", n, block_size, std::size_t{0},
         [&](std::size_t b, std::size_t e) {
           std::size_t c = 0;
@@ -48,7 +48,7 @@ class OccupiedCellTable {
     shift_ = 64 - static_cast<unsigned>(std::countr_zero(slots));
     mask_ = slots - 1;
     slots_.assign(slots, Slot{});
-    parallel::for_blocks("cell_hash_build", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    parallel::for_blocks_pinned("cell_hash_build", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       for (std::size_t i = b; i < e; ++i) {
         if (i > 0 && keys[i] == keys[i - 1]) continue;  // not the first particle of its cell
         std::size_t end = i + 1;

@@ -46,7 +46,7 @@ class ParticleReorder {
     // bytes, made this stage scale worst on 2 threads at 35 000 particles.
     for (std::size_t first = 0; first < fields.size(); first += kGroup) {
       const std::size_t count = std::min(kGroup, fields.size() - first);
-      parallel::for_blocks("reorder", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      parallel::for_blocks_pinned("reorder", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
         for (std::size_t k = 0; k < count; ++k) {
           const Real* from = fields[first + k]->data();
           Real* to = scratch_[k].data();

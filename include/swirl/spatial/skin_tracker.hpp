@@ -32,7 +32,7 @@ class SkinTracker {
     const std::size_t n = p.size();
     for (auto* v : {&x_, &y_, &z_}) v->resize(n);
     ids_.resize(n);
-    parallel::for_blocks("skin_remember", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    parallel::for_blocks_pinned("skin_remember", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       std::copy(p.position.x.data() + b, p.position.x.data() + e, x_.data() + b);
       std::copy(p.position.y.data() + b, p.position.y.data() + e, y_.data() + b);
       std::copy(p.position.z.data() + b, p.position.z.data() + e, z_.data() + b);
@@ -49,7 +49,7 @@ class SkinTracker {
   double max_displacement2(const ParticleSet<Real>& p, std::size_t block_size) const {
     constexpr double kDifferent = std::numeric_limits<double>::infinity();
     if (!valid_ || p.size() != ids_.size()) return kDifferent;
-    return parallel::reduce_blocks(
+    return parallel::reduce_blocks_pinned(
         "skin_displacement", p.size(), block_size, 0.0,
         [&](std::size_t b, std::size_t e) {
           const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();

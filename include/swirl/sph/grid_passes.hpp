@@ -116,7 +116,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
     a.x = x, a.y = y, a.z = z, a.mass = m, a.density = rho, a.pressure = pr;
     a.volume = volume, a.pressure_volume = pressure_volume, a.n = n;
     a.h2 = h2, a.poly6_norm = w.norm, a.rest_density = k.rest_density, a.c2 = k.c2, a.pressure_floor = k.pressure_floor;
-    return parallel::reduce_blocks(
+    return parallel::reduce_blocks_pinned(
         "sph_grid_density", n, block_size, std::uint64_t{0},
         [&](std::size_t b, std::size_t e) {
           std::uint64_t pairs = 0;
@@ -127,7 +127,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
         },
         sum_blocks);
   } else {
-    return parallel::reduce_blocks(
+    return parallel::reduce_blocks_pinned(
         "sph_grid_density", n, block_size, std::uint64_t{0},
         [&](std::size_t b, std::size_t e) {
           std::uint64_t pairs = 0;
@@ -182,7 +182,7 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     a.volume = V, a.pressure_volume = PV, a.pressure = pr, a.density = rho;
     a.ax = ax, a.ay = ay, a.az = az, a.n = n;
     a.h = h, a.h2 = h2, a.pressure_norm = pressure_norm, a.visc_norm = visc_norm;
-    parallel::for_blocks("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
         forces_cell_simd(a, first, last, detail::KernelRanges(ranges, count).data(), count);
       });
@@ -208,7 +208,7 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     s.vy += fv * (vy[j] - vy[i]);
     s.vz += fv * (vz[j] - vz[i]);
   };
-  parallel::for_blocks("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+  parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
       Sums s;
       for (int r = 0; r < count; ++r)
