@@ -66,7 +66,9 @@ void add_bench_commands(CLI::App& app, Commands& commands) {
   c->add_option("--neighbours", sph->neighbours, "Measured neighbours per particle to aim at")
       ->delimiter(',')
       ->check(CLI::Range(1.0, 500.0));
-  c->add_option("--strategy", sph->strategies, "Neighbour search(es): sph.neighbour_search values (default: the scene's)")
+  c->add_option("--strategy", sph->strategies,
+                "Neighbour search(es): sph.neighbour_search values, the grid's with options, e.g. "
+                "grid+morton+hashed+skin=0.1h (+rows|morton, +dense|hashed, +skin=X or Xh; default: the scene's)")
       ->delimiter(',');
   c->add_option("--settle", sph->settle, "Steps to settle the random start before timing (the thesis: 3000)")
       ->check(CLI::NonNegativeNumber);
