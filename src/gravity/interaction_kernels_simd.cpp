@@ -24,6 +24,7 @@
 
 #include <xsimd/xsimd.hpp>
 
+#include "swirl/core/simd_rsqrt.hpp"
 #include "swirl/gravity/interaction_kernels.hpp"
 
 // GCC 12 reports the deliberately undefined pass-through operand of the
@@ -47,46 +48,11 @@ using Batch = xsimd::batch<T>;
 // and division. A Newton step y ← ½ y (3 − x y²) leaves its ½ out when it is
 // the last: the kernels get z = 2/√x and fold the powers of 2 into their sums
 // at the end (exact), which saves a multiply per pair.
-#if defined(__SSE__)
-constexpr bool kFloatEstimate = true;
-#else
-constexpr bool kFloatEstimate = false;
-#endif
-#if defined(__AVX512F__)
-constexpr bool kDoubleEstimate = true;
-#else
-constexpr bool kDoubleEstimate = false;
-#endif
-
 template <class T>
 struct Root {
-  static constexpr bool estimate = std::is_same_v<T, float> ? kFloatEstimate : kDoubleEstimate;
+  static constexpr bool estimate = simd::SWIRL_SIMD_NS::kHasRsqrtEstimate<T>;
   static constexpr T scale = estimate ? T(2) : T(1);  // z = scale / √x
 };
-
-inline Batch<float> rsqrt_estimate(const Batch<float>& x) {
-#if defined(__AVX512F__)
-  static_assert(Batch<float>::size == 16);
-  return Batch<float>(_mm512_rsqrt14_ps(x));
-#elif defined(__AVX__)
-  static_assert(Batch<float>::size == 8);
-  return Batch<float>(_mm256_rsqrt_ps(x));
-#elif defined(__SSE__)
-  static_assert(Batch<float>::size == 4);
-  return Batch<float>(_mm_rsqrt_ps(x));
-#else
-  return Batch<float>(1.0f) / xsimd::sqrt(x);  // not reached: kFloatEstimate is false
-#endif
-}
-
-inline Batch<double> rsqrt_estimate(const Batch<double>& x) {
-#if defined(__AVX512F__)
-  static_assert(Batch<double>::size == 8);
-  return Batch<double>(_mm512_rsqrt14_pd(x));
-#else
-  return Batch<double>(1.0) / xsimd::sqrt(x);  // not reached: kDoubleEstimate is false
-#endif
-}
 
 // z = Root<T>::scale / √x for normal, finite x > 0; with Guard, z = 0 where
 // x = 0 (a pair at zero softened distance contributes nothing). Without
@@ -99,7 +65,7 @@ inline Batch<T> scaled_inverse_sqrt(const Batch<T>& x) {
   if constexpr (!Root<T>::estimate) {
     z = B(T(1)) / xsimd::sqrt(x);
   } else {
-    B y = rsqrt_estimate(x);
+    B y = simd::SWIRL_SIMD_NS::rsqrt_estimate(x);
     if constexpr (std::is_same_v<T, double>) y = B(T(0.5)) * y * xsimd::fnma(x * y, y, B(T(3)));
     z = y * xsimd::fnma(x * y, y, B(T(3)));
   }

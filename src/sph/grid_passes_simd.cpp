@@ -10,6 +10,7 @@
 
 #include <xsimd/xsimd.hpp>
 
+#include "swirl/core/simd_rsqrt.hpp"
 #include "swirl/sph/grid_pass_kernels.hpp"
 
 // GCC 12 reports the deliberately undefined pass-through operand of the
@@ -50,29 +51,8 @@ Real live_lanes(std::size_t left) {
 template <class B>
 B inverse_sqrt(const B& x) {
   using T = typename B::value_type;
-  if constexpr (std::is_same_v<T, float>) {
-    B y;
-    if constexpr (B::size == 16) {
-#if defined(__AVX512F__)
-      y = B(_mm512_rsqrt14_ps(x));
-#else
-      return B(T(1)) / xsimd::sqrt(x);
-#endif
-    } else if constexpr (B::size == 8) {
-#if defined(__AVX__)
-      y = B(_mm256_rsqrt_ps(x));
-#else
-      return B(T(1)) / xsimd::sqrt(x);
-#endif
-    } else if constexpr (B::size == 4) {
-#if defined(__SSE__)
-      y = B(_mm_rsqrt_ps(x));
-#else
-      return B(T(1)) / xsimd::sqrt(x);
-#endif
-    } else {
-      return B(T(1)) / xsimd::sqrt(x);
-    }
+  if constexpr (std::is_same_v<T, float> && simd::SWIRL_SIMD_NS::kHasRsqrtEstimate<float>) {
+    const B y = simd::SWIRL_SIMD_NS::rsqrt_estimate(x);
     return y * (B(T(1.5)) - B(T(0.5)) * x * y * y);
   } else {
     return B(T(1)) / xsimd::sqrt(x);
