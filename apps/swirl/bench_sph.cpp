@@ -87,6 +87,13 @@ struct Settled {
   std::size_t warnings = 0;   // guard events while settling (see settle())
 };
 
+// The run's SPH solver (this bench runs SPH scenes only).
+const sph::SphFluid<float>& fluid_of(const Simulation<float>& run) {
+  const auto* fluid = run.find_solver<sph::SphFluid<float>>();
+  if (!fluid) throw std::logic_error("sph bench: the scene has no SPH solver");
+  return *fluid;
+}
+
 // Settles on one thread: the state is bit-identical for any thread count, and
 // one thread is the robust choice on a loaded machine (settling is not timed).
 Settled settle(std::size_t n, double aimed_k, int steps) {
@@ -95,24 +102,24 @@ Settled settle(std::size_t n, double aimed_k, int steps) {
   double initial = 0;
   {
     auto probe = sim::build_simulation<float>(random_box(n, target));
-    probe.sim.start();
-    initial = probe.fluid->mean_neighbors();
+    probe.start();
+    initial = fluid_of(probe).mean_neighbors();
     if (initial > 0) target = aimed_k * aimed_k / initial;
   }
   Settled s{random_box(n, target), {}, target, 0, 0, 0};
-  auto built = sim::build_simulation<float>(s.scene);
+  auto run = sim::build_simulation<float>(s.scene);
   // The thesis's fixed Δt = 0.003 s exceeds the force condition while the
   // random start (overlapping particles) relaxes: that is the experiment, so
   // the guard warns (counted) instead of stopping; a non-finite state still stops.
-  built.sim.set_on_blow_up(OnBlowUp::Warn);
-  built.sim.start();
-  s.initial_k = built.fluid->mean_neighbors();
+  run.set_on_blow_up(OnBlowUp::Warn);
+  run.start();
+  s.initial_k = fluid_of(run).mean_neighbors();
   for (int i = 0; i < steps; ++i) {
-    built.sim.step();
-    s.warnings += built.sim.take_events().size();
+    run.step();
+    s.warnings += run.take_events().size();
   }
-  s.settled_k = built.fluid->mean_neighbors();
-  s.particles = built.sim.particles();
+  s.settled_k = fluid_of(run).mean_neighbors();
+  s.particles = run.particles();
   return s;
 }
 
@@ -128,24 +135,24 @@ struct Timing {
 // Times `steps` steps from the settled state with `threads` threads.
 Timing time_steps(const scene::Scene& scene, const ParticleSet<float>& start, int steps, int threads) {
   parallel::set_thread_count(threads);
-  auto built = sim::build_simulation<float>(scene);
-  built.sim.set_on_blow_up(OnBlowUp::Warn);  // as while settling; the checks still run
-  built.sim.particles() = start;
-  built.sim.start();
-  built.sim.timers() = PhaseTimers{};
+  auto run = sim::build_simulation<float>(scene);
+  run.set_on_blow_up(OnBlowUp::Warn);  // as while settling; the checks still run
+  run.particles() = start;
+  run.start();
+  run.timers() = PhaseTimers{};
   Timing t;
   t.steps = steps;
-  const auto sorts_before = built.fluid->grid_sorts();
+  const auto sorts_before = run.order().sorts();
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < steps; ++s) {
-    built.sim.step();
-    t.mean_k += built.fluid->mean_neighbors();
-    t.warnings += built.sim.take_events().size();
+    run.step();
+    t.mean_k += fluid_of(run).mean_neighbors();
+    t.warnings += run.take_events().size();
   }
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   t.mean_k /= steps;
-  t.sorts = double(built.fluid->grid_sorts() - sorts_before) / steps;
-  for (const auto& [name, sec] : built.sim.timers().phases()) {
+  t.sorts = double(run.order().sorts() - sorts_before) / steps;
+  for (const auto& [name, sec] : run.timers().phases()) {
     if (name == "forces.search" || name == "forces.density") t.search += sec;
     else if (name == "forces.sph") t.forces += sec;
     else if (name == "integrate") t.integrate += sec;

@@ -107,16 +107,17 @@ void BM_Search(benchmark::State& state) {
   auto p = random_box(n);
   const auto s = params_for(n, grid ? sph::NeighbourSearch::Grid : sph::NeighbourSearch::Hash, true);
   spatial::SortedCellGrid<Real> cells;
-  spatial::ParticleReorder<Real> reorder;
+  spatial::ParticleOrder<Real> order;  // the grid's search: the shared order's sort, then the cell index
+  order.set_request(sph::SphFluid<Real>(s).order_request());
   spatial::SpatialHash<Real> hash;
   spatial::NeighborList<Real> lists;
   const sph::Poly6<Real> w(Real(s.smoothing_length));
   double neighbours = 0;
   for (auto _ : state) {
     if (grid) {
-      cells.sort(p, s.smoothing_length, kBlock);
-      reorder.apply(p, cells.order(), kBlock);
-      cells.index(kBlock);
+      order.touch();  // sort every iteration, as a step without a skin does
+      order.update(p, kBlock);
+      cells.view(order, kBlock);
       benchmark::DoNotOptimize(p.position.x.data());
     } else {
       hash.build(p, Real(s.smoothing_length), sph::default_bucket_count(n), kBlock);
@@ -131,7 +132,7 @@ void BM_Search(benchmark::State& state) {
   }
   if (grid) {  // the pairs the grid's passes will process
     sph::SphFluid<Real> fluid(s);
-    fluid.add_acceleration(p, ForceContext{0, kBlock, nullptr});
+    evaluate_alone(fluid, p, kBlock);
     neighbours = fluid.mean_neighbors();
   }
   report(state, n, neighbours);
@@ -147,7 +148,8 @@ void grid_pass(benchmark::State& state) {
   auto p = random_box(n);
   const auto s = params_for(n, sph::NeighbourSearch::Grid, simd);
   sph::SphFluid<Real> fluid(s);
-  fluid.add_acceleration(p, ForceContext{0, kBlock, nullptr});  // sorts p and fills density
+  spatial::ParticleOrder<Real> order;  // the grid is a view of it
+  evaluate_alone(fluid, p, order, kBlock);  // sorts p and fills density
   const auto k = constants(s);
   sph::GridScratch<Real> scratch;
   sph::grid_density<Real, true>(fluid.grid(), p, k, kBlock, scratch);
@@ -180,7 +182,7 @@ void BM_Step(benchmark::State& state) {
   auto model = std::make_unique<sph::SphFluid<Real>>(
       params_for(n, grid ? sph::NeighbourSearch::Grid : sph::NeighbourSearch::Hash, state.range(3) != 0));
   const auto* fluid = model.get();
-  sim.add_force(std::move(model));
+  sim.add_solver(std::move(model));
   sim.start();
   for (auto _ : state) sim.step();
   report(state, n, fluid->mean_neighbors());
@@ -273,7 +275,8 @@ void BM_Lists(benchmark::State& state) {
   auto p = random_box(n);
   const auto s = params_for(n, sph::NeighbourSearch::Grid, true);
   sph::SphFluid<Real> fluid(s);
-  fluid.add_acceleration(p, ForceContext{0, kBlock, nullptr});
+  spatial::ParticleOrder<Real> order;  // the grid is a view of it
+  evaluate_alone(fluid, p, order, kBlock);
   const auto k = constants(s);
   const sph::Poly6<Real> w(k.h);
   const sph::Spiky<Real> spiky(k.h);

@@ -61,19 +61,24 @@ BarnesHut<Real>::BarnesHut(const GravitySettings& settings) : settings_(settings
 
 template <class Real>
 void BarnesHut<Real>::compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size) {
-  compute_impl(p, nullptr, out, block_size);
+  compute_impl(p, out, block_size);
 }
 
 template <class Real>
-void BarnesHut<Real>::compute_reordering(ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size) {
-  compute_impl(p, &p, out, block_size);
-}
-
-template <class Real>
-void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, ParticleSet<Real>* reorder, GravityField<Real>& out,
+void BarnesHut<Real>::compute_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
+                                     const std::array<double, 3>& corner, double side, GravityField<Real>& out,
                                      std::size_t block_size) {
-  const std::size_t n = p.size();
+  if (!uses_linear_tree()) throw std::logic_error("BarnesHut::compute_sorted: only the linear tree is a view of an order");
+  if (block_size == 0) throw std::invalid_argument("gravity: block size must be at least 1");
+  out.resize(p.size());
+  stats_ = GravityStats{};
   const auto t0 = Clock::now();
+  linear_.build_sorted(p, sorted_keys, corner, side, linear_settings(), block_size);
+  evaluate_linear(p.size(), out, block_size, seconds_since(t0));
+}
+
+template <class Real>
+LinearTreeSettings BarnesHut<Real>::linear_settings() const {
   LinearTreeSettings ls;
   ls.multipole = settings_.multipole;
   ls.criterion = settings_.criterion;
@@ -82,16 +87,20 @@ void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, ParticleSet<Rea
   ls.bucket_size = settings_.bucket_size;
   ls.walk = settings_.walk;
   ls.group_size = settings_.group_size;
-  linear_.build(p, ls, block_size);
-  if (reorder) {
-    // Physically along the curve: the walk then reads, and the integrator
-    // streams, neighbouring particles from neighbouring memory.
-    const auto order = linear_.order();
-    permutation_.assign(order.begin(), order.end());
-    reorder->reorder(permutation_);
-    linear_.adopt_curve_order();
-  }
-  stats_.tree_build_seconds = seconds_since(t0);
+  return ls;
+}
+
+template <class Real>
+void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size) {
+  const auto t0 = Clock::now();
+  linear_.build(p, linear_settings(), block_size);
+  evaluate_linear(p.size(), out, block_size, seconds_since(t0));
+}
+
+template <class Real>
+void BarnesHut<Real>::evaluate_linear(std::size_t n, GravityField<Real>& out, std::size_t block_size,
+                                      double build_seconds) {
+  stats_.tree_build_seconds = build_seconds;
   const auto t1 = Clock::now();
   const WalkCounts counts = linear_.evaluate(out, block_size);
   stats_.force_seconds = seconds_since(t1);
@@ -99,7 +108,7 @@ void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, ParticleSet<Rea
   stats_.nodes = linear_.nodes().size();
   stats_.depth = linear_.depth();
   stats_.leaves = linear_.leaf_count();
-  stats_.tree_bytes = linear_.bytes() + permutation_.capacity() * sizeof(std::size_t);
+  stats_.tree_bytes = linear_.bytes();
   stats_.mean_nodes_visited = n ? double(counts.nodes) / double(n) : 0.0;
   stats_.mean_interactions = n ? double(counts.multipoles + counts.pairs) / double(n) : 0.0;
   work_.assign(1, counts.nodes);
@@ -107,14 +116,14 @@ void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, ParticleSet<Rea
 }
 
 template <class Real>
-void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, ParticleSet<Real>* reorder, GravityField<Real>& out,
+void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real>& out,
                                    std::size_t block_size) {
   if (block_size == 0) throw std::invalid_argument("gravity: block size must be at least 1");
   if (p.size() >= Octree<Real>::npos) throw std::invalid_argument("gravity: too many particles for 32-bit tree indices");
   const std::size_t n = p.size();
   out.resize(n);
   stats_ = GravityStats{};
-  if (uses_linear_tree()) return compute_linear(p, reorder, out, block_size);
+  if (uses_linear_tree()) return compute_linear(p, out, block_size);
 
   const auto t0 = Clock::now();
   std::vector<std::uint64_t> weights;

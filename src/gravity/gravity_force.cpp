@@ -1,17 +1,46 @@
 #include "swirl/gravity/gravity_force.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <stdexcept>
 
+#include <fmt/format.h>
+
+#include "swirl/gravity/diagnostics.hpp"
 #include "swirl/gravity/direct_sum.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::gravity {
 
 template <class Real>
-GravityForce<Real>::GravityForce(const GravitySettings& settings) : settings_(settings), tree_(settings) {}
+GravityForce<Real>::GravityForce(const GravitySettings& settings, const SelfGravityOptions& options)
+    : settings_(settings), options_(options), tree_(settings) {
+  if (!(options.G > 0) || !std::isfinite(options.G))
+    throw std::invalid_argument("gravity: the gravitational constant G must be finite and > 0");
+  if (!(options.eta > 0) || !std::isfinite(options.eta))
+    throw std::invalid_argument("gravity: the time-step factor eta must be finite and > 0");
+}
 
 template <class Real>
-void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const ForceContext& ctx) {
+bool GravityForce<Real>::views_order() const {
+  return settings_.method == Method::barnes_hut && settings_.reorder && tree_.uses_linear_tree();
+}
+
+template <class Real>
+void GravityForce<Real>::declare_fields(ParticleSet<Real>& p) {
+  p.add_field("potential", 1);
+}
+
+template <class Real>
+spatial::OrderRequest GravityForce<Real>::order_request() const {
+  // Nodes must bound their particles, so the keys must be this step's: no tolerance.
+  if (views_order()) return {true, 0, 0, spatial::CellOrder::Morton};
+  return {};
+}
+
+template <class Real>
+void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
   if (settings_.method == Method::direct) {
     const auto t0 = std::chrono::steady_clock::now();
     direct_sum(p, Real(settings_.softening), ctx.block_size, field_);
@@ -19,27 +48,92 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const ForceConte
     stats_.mean_nodes_visited = p.empty() ? 0.0 : double(p.size() - 1);
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   } else {
-    if (settings_.reorder)
-      tree_.compute_reordering(p, field_, ctx.block_size);  // reorders p with the linear tree
-    else
+    const auto* order = ctx.order;
+    if (views_order() && order && order->valid() && order->frame().curve == spatial::CellOrder::Morton &&
+        order->keys().size() == p.size()) {
+      const auto& f = order->frame();
+      tree_.compute_sorted(p, order->keys(), f.corner, f.root_side(), field_, ctx.block_size);
+    } else {
       tree_.compute(p, field_, ctx.block_size);
+    }
     stats_ = tree_.stats();
   }
   const std::size_t phi_field = p.add_field("potential", 1);
   Real* phi = p.extra(phi_field).data();
+  const Real G = Real(options_.G);
+  const bool unit = options_.G == 1;
   parallel::for_blocks("gravity_add", p.size(), ctx.block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     for (int a = 0; a < 3; ++a) {
       Real* acc = p.acceleration[a].data();
       const Real* add = field_.acceleration[a].data();
+      if (unit) {  // N-body units: exactly the walk's values
 #pragma omp simd
-      for (std::size_t i = b; i < e; ++i) acc[i] += add[i];
+        for (std::size_t i = b; i < e; ++i) acc[i] += add[i];
+      } else {
+#pragma omp simd
+        for (std::size_t i = b; i < e; ++i) acc[i] += G * add[i];
+      }
     }
-    for (std::size_t i = b; i < e; ++i) phi[i] = field_.potential[i];
+    for (std::size_t i = b; i < e; ++i) phi[i] = unit ? field_.potential[i] : G * field_.potential[i];
   });
   if (ctx.timers) {
     ctx.timers->add("forces.tree_build", stats_.tree_build_seconds);
     ctx.timers->add("forces.walk", stats_.force_seconds);
   }
+  nodes_sum_ += stats_.mean_nodes_visited;
+  ++evaluations_;
+  particles_ = p.size();
+}
+
+template <class Real>
+void GravityForce<Real>::add_limits(const StepScan& scan, std::size_t n, std::vector<StepLimit>& out) const {
+  const double accel = std::sqrt(scan.accel2);
+  double length = settings_.softening;
+  if (!(length > 0) && n > 1) {
+    double extent = 0;
+    for (int axis = 0; axis < 3; ++axis) extent = std::max(extent, scan.hi[axis] - scan.lo[axis]);
+    length = extent / std::cbrt(static_cast<double>(n));
+  }
+  if (accel > 0 && length > 0)
+    out.push_back({"gravity", options_.eta * std::sqrt(length / accel), scan.accel_at, accel, "|a|"});
+}
+
+template <class Real>
+LimitText GravityForce<Real>::explain(const StepLimit& l, std::string_view id) const {
+  return {fmt::format("the gravity condition η·sqrt({}/|a|max) with η = {} = {:.6g} (|a|max = {:.3g} at particle id {})",
+                      settings_.softening > 0 ? "ε" : "d", options_.eta, l.dt, l.value, id),
+          "or a larger softening ε"};
+}
+
+template <class Real>
+void GravityForce<Real>::add_diagnostics(const ParticleSet<Real>& p, std::size_t block_size,
+                                         std::vector<double>& row) const {
+  const Diagnostics d = diagnose(p, block_size);
+  row.insert(row.end(), {d.virial_ratio, stats_.mean_nodes_visited});
+}
+
+template <class Real>
+double GravityForce<Real>::potential_energy(const ParticleSet<Real>& p, std::size_t block_size) const {
+  return gravity::potential_energy(p, block_size);
+}
+
+template <class Real>
+void GravityForce<Real>::add_metrics(NamedValues& out) const {
+  out.emplace_back("mean_nodes_visited", evaluations_ > 0 ? nodes_sum_ / double(evaluations_) : stats_.mean_nodes_visited);
+  if (stats_.tree_bytes > 0 && particles_ > 0)
+    out.emplace_back("tree_bytes_per_particle", double(stats_.tree_bytes) / double(particles_));
+}
+
+template <class Real>
+void GravityForce<Real>::save_state(NamedValues& out) const {
+  out.emplace_back("self_gravity.nodes_sum", nodes_sum_);
+  out.emplace_back("self_gravity.evaluations", double(evaluations_));
+}
+
+template <class Real>
+void GravityForce<Real>::load_state(const NamedValues& values) {
+  nodes_sum_ = find_value(values, "self_gravity.nodes_sum").value_or(0.0);
+  evaluations_ = static_cast<std::uint64_t>(find_value(values, "self_gravity.evaluations").value_or(0.0));
 }
 
 template class GravityForce<float>;

@@ -48,14 +48,46 @@ Real to_real_radius2(double r2) {
 }  // namespace
 
 template <class Real>
-void LinearOctree<Real>::build(const ParticleSet<Real>& p, const LinearTreeSettings& settings, std::size_t block_size) {
+void LinearOctree<Real>::check(const ParticleSet<Real>& p, const LinearTreeSettings& settings,
+                               std::size_t block_size) const {
   if (block_size == 0) throw std::invalid_argument("linear octree: block size must be at least 1");
   if (settings.bucket_size < 1) throw std::invalid_argument("linear octree: bucket size must be at least 1");
   if (settings.group_size < 1) throw std::invalid_argument("linear octree: group size must be at least 1");
   if (p.size() >= npos) throw std::invalid_argument("linear octree: too many particles for 32-bit indices");
+}
+
+template <class Real>
+void LinearOctree<Real>::build(const ParticleSet<Real>& p, const LinearTreeSettings& settings, std::size_t block_size) {
+  check(p, settings, block_size);
   settings_ = settings;
   block_size_ = block_size;
   make_keys(p, block_size);
+  make_nodes();
+  make_multipoles();
+  make_groups();
+}
+
+template <class Real>
+void LinearOctree<Real>::build_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
+                                      const std::array<double, 3>& corner, double side,
+                                      const LinearTreeSettings& settings, std::size_t block_size) {
+  check(p, settings, block_size);
+  if (sorted_keys.size() != p.size()) throw std::invalid_argument("linear octree: one key per particle expected");
+  if (!(side > 0) || !std::isfinite(side)) throw std::invalid_argument("linear octree: the key cube's side must be > 0");
+  settings_ = settings;
+  block_size_ = block_size;
+  corner_ = corner;
+  side_ = side;
+  keys_ = sorted_keys;
+  const std::size_t n = p.size();
+  x_ = {p.position.x.data(), n};
+  y_ = {p.position.y.data(), n};
+  z_ = {p.position.z.data(), n};
+  m_ = {p.mass.data(), n};
+  order_.resize(n);
+  parallel::for_blocks("linear_octree_identity", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t s = b; s < e; ++s) order_[s] = std::uint32_t(s);
+  });
   make_nodes();
   make_multipoles();
   make_groups();
@@ -124,29 +156,34 @@ void LinearOctree<Real>::make_keys(const ParticleSet<Real>& p, std::size_t block
     }
   });
   sorter_.sort(raw_keys_, 3 * kLevels);
+  keys_ = sorter_.keys();
 
   const auto order = sorter_.order();
   order_.resize(n);
-  x_.resize(n);
-  y_.resize(n);
-  z_.resize(n);
-  m_.resize(n);
+  own_x_.resize(n);
+  own_y_.resize(n);
+  own_z_.resize(n);
+  own_m_.resize(n);
   parallel::for_blocks("linear_octree_gather", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     for (std::size_t s = b; s < e; ++s) {
       const std::uint32_t i = order[s];
       order_[s] = i;
-      x_[s] = p.position.x[i];
-      y_[s] = p.position.y[i];
-      z_[s] = p.position.z[i];
-      m_[s] = p.mass[i];
+      own_x_[s] = p.position.x[i];
+      own_y_[s] = p.position.y[i];
+      own_z_[s] = p.position.z[i];
+      own_m_[s] = p.mass[i];
     }
   });
+  x_ = own_x_;
+  y_ = own_y_;
+  z_ = own_z_;
+  m_ = own_m_;
 }
 
 template <class Real>
 void LinearOctree<Real>::make_nodes() {
   const std::size_t n = x_.size();
-  const std::span<const std::uint64_t> keys = sorter_.keys();
+  const std::span<const std::uint64_t> keys = keys_;
   LinearNodes<Real>& t = nodes_;
   auto resize = [&](std::size_t count) {
     t.begin.resize(count);
@@ -595,12 +632,12 @@ std::size_t LinearOctree<Real>::bytes() const {
     b += a->capacity() * sizeof(Real);
   b += (t.begin.capacity() + t.end.capacity() + t.first_child.capacity()) * sizeof(std::uint32_t);
   b += t.child_count.capacity() + t.level.capacity() + t.prefix.capacity() * sizeof(std::uint64_t);
-  b += (x_.capacity() + y_.capacity() + z_.capacity() + m_.capacity()) * sizeof(Real);
+  b += (own_x_.capacity() + own_y_.capacity() + own_z_.capacity() + own_m_.capacity()) * sizeof(Real);
   b += order_.capacity() * sizeof(std::uint32_t) + raw_keys_.capacity() * sizeof(std::uint64_t);
   b += (groups_.capacity() + schedule_.capacity()) * sizeof(std::uint32_t) + slot_cost_.capacity() * sizeof(double);
   b += group_counts_.capacity() * sizeof(WalkCounts);
-  // The sort's key and order arrays, each with its spare (radix_sort.hpp).
-  b += x_.size() * 2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+  // The own sort's key and order arrays, each with its spare (radix_sort.hpp).
+  if (!own_x_.empty()) b += x_.size() * 2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
   return b;
 }
 

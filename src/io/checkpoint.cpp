@@ -73,9 +73,12 @@ CheckpointHeader parse_header(Cursor& in) {
   if (in.take(kMagic.size(), "the magic") != kMagic) throw detail::Malformed("not a swirl checkpoint (bad magic)");
   const auto version = in.get<std::uint32_t>("the version");
   if (version != kCheckpointVersion)
-    throw detail::Malformed(fmt::format("format version {} is not supported: this swirl reads version {} only{}",
-                                        version, kCheckpointVersion,
-                                        version < kCheckpointVersion ? " (written by an older swirl)" : ""));
+    throw detail::Malformed(fmt::format(
+        "format version {} is not supported: this swirl reads version {} only{}", version, kCheckpointVersion,
+        version == 1 ? " (version 1 was written before the run state moved under owner prefixes such as "
+                       "\"frames.written\" and \"clock.previous_dt\"; resume it with the swirl that wrote it)"
+        : version < kCheckpointVersion ? " (written by an older swirl)"
+                                       : " (written by a newer swirl)"));
   CheckpointHeader h;
   h.real_bytes = in.get<std::uint32_t>("the precision");
   if (h.real_bytes != 4 && h.real_bytes != 8)

@@ -30,7 +30,7 @@ void write_csv(const std::filesystem::path& path, const ParticleSet<Real>& parti
   // fmt's "{}" is the shortest representation that reads back to the same value.
   std::string out = fmt::format("# time = {}\nid,x,y,z", time);
   for (const auto& f : fields) {
-    if (f.name == "position") continue;
+    if (f.name == "position" || f.internal) continue;
     if (f.components == 1) {
       out += ',' + csv_cell(f.name);
     } else {
@@ -44,7 +44,7 @@ void write_csv(const std::filesystem::path& path, const ParticleSet<Real>& parti
     fmt::format_to(sink, "{},{},{},{}", particles.id[i], particles.position.x[i], particles.position.y[i],
                    particles.position.z[i]);
     for (const auto& f : fields) {
-      if (f.name == "position") continue;
+      if (f.name == "position" || f.internal) continue;
       for (int c = 0; c < f.components; ++c) fmt::format_to(sink, ",{}", f.data[c][i]);
     }
     out += '\n';

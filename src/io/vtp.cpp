@@ -334,7 +334,7 @@ void write_vtp(const fs::path& path, const ParticleSet<Real>& particles, double 
 
   b.line("      <PointData>");
   for (const auto& f : fields)
-    if (f.name != "position") put_field(b, "        ", f, n, f.name);
+    if (f.name != "position" && !f.internal) put_field(b, "        ", f, n, f.name);
   out = b.array<std::uint64_t>("        ", "id", 1, n);
   for (std::size_t i = 0; i < n; ++i) put(out, particles.id[i]);
   b.line("      </PointData>");

@@ -9,12 +9,12 @@ namespace {
 
 template <class Real>
 spatial::HashStatistics measure(const scene::Scene& scene, std::uint64_t steps) {
-  auto built = build_simulation<Real>(scene);
+  auto sim = build_simulation<Real>(scene);
   if (steps > 0) {
-    built.sim.start();
-    for (std::uint64_t s = 0; s < steps; ++s) built.sim.step();
+    sim.start();
+    for (std::uint64_t s = 0; s < steps; ++s) sim.step();
   }
-  const auto& p = built.sim.particles();
+  const auto& p = sim.particles();
   const auto& params = *scene.sph;
   const std::uint32_t buckets = params.buckets ? params.buckets : sph::default_bucket_count(p.size());
   return spatial::hash_statistics(p, Real(params.smoothing_length), buckets, scene.block_size);

@@ -19,104 +19,238 @@
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/build.hpp"
-#include "swirl/gravity/diagnostics.hpp"
-#include "swirl/sph/diagnostics.hpp"
+#include "swirl/sim/observer.hpp"
 
 namespace swirl::sim {
 namespace {
 
-// Writes frames in the scene's formats and keeps the .pvd series current.
+// ---------------------------------------------------------------------------
+// Frames: particles_NNNNNN.vtp/.csv at the output interval, frame 0 at the
+// start, the final state at the end; particles.pvd kept current.
 template <class Real>
-class FrameWriter {
+class FrameWriter final : public Observer<Real> {
  public:
-  FrameWriter(const scene::Scene& scene, const std::filesystem::path& dir)
-      : scene_(scene), dir_(dir), series_(dir / "particles.pvd") {}
+  FrameWriter(const scene::Scene& scene, const RunOptions& options)
+      : formats_(scene.formats), dir_(options.out_dir), series_(dir_ / "particles.pvd"),
+        schedule_(scene.output_interval, scene.dt), on_frame_(options.on_frame) {}
 
-  // Continues after the first `frames` frames (those written before the
-  // checkpoint; later ones, such as the final frame of a run that went on
-  // past it, are replaced).
-  void resume(std::size_t frames) {
-    frames_ = frames;
+  std::string_view name() const override { return "frames"; }
+  void on_start(Simulation<Real>& sim, bool resumed) override {
+    if (!resumed) write(sim);
+  }
+  void on_step(Simulation<Real>& sim) override {
+    if (!schedule_.due(sim.time())) return;
+    write(sim);
+    schedule_.acted(sim.time());
+  }
+  void on_finish(Simulation<Real>& sim) override {
+    if (last_step_ != sim.step_count() || frames_ == 0) write(sim);
+  }
+  std::optional<double> next_time(const Simulation<Real>&) const override { return schedule_.next_time(); }
+
+  void save_state(NamedValues& out) const override {
+    out.emplace_back("frames.written", double(frames_));
+    out.emplace_back("frames.next", double(schedule_.next_index()));
+    out.emplace_back("frames.last_step", double(last_step_));
+  }
+  // Continues after the frames written before the checkpoint; later ones
+  // (such as the final frame of a run that went on past it) are replaced.
+  void load_state(const NamedValues& values) override {
+    frames_ = static_cast<std::size_t>(find_value(values, "frames.written").value_or(0));
+    schedule_.set_next_index(static_cast<std::uint64_t>(find_value(values, "frames.next").value_or(1)));
+    last_step_ = static_cast<std::uint64_t>(find_value(values, "frames.last_step").value_or(0));
     const auto pvd = dir_ / "particles.pvd";
     if (!std::filesystem::exists(pvd)) return;
     auto entries = io::read_pvd(pvd);
-    if (entries.size() > frames) entries.resize(frames);
+    if (entries.size() > frames_) entries.resize(frames_);
     series_.set_entries(std::move(entries));
-  }
-
-  // Writes frame number frames() and returns its first file.
-  std::filesystem::path write(const ParticleSet<Real>& p, double time) {
-    std::filesystem::path first;
-    for (auto format : scene_.formats) {
-      std::filesystem::path file;
-      if (format == scene::OutputFormat::Vtp) {
-        const std::string name = fmt::format("particles_{:06d}.vtp", frames_);
-        file = dir_ / name;
-        io::write_vtp(file, p, time);
-        series_.add(time, name);
-      } else {
-        file = dir_ / fmt::format("particles_{:06d}.csv", frames_);
-        io::write_csv(file, p, time);
-      }
-      if (first.empty()) first = file;
-    }
-    ++frames_;
-    return first;
   }
   std::size_t frames() const { return frames_; }
 
  private:
-  const scene::Scene& scene_;
+  void write(Simulation<Real>& sim) {
+    ScopedPhase phase(sim.timers(), "output");
+    std::filesystem::path first;
+    for (auto format : formats_) {
+      std::filesystem::path file;
+      if (format == scene::OutputFormat::Vtp) {
+        const std::string name = fmt::format("particles_{:06d}.vtp", frames_);
+        file = dir_ / name;
+        io::write_vtp(file, sim.particles(), sim.time());
+        series_.add(sim.time(), name);
+      } else {
+        file = dir_ / fmt::format("particles_{:06d}.csv", frames_);
+        io::write_csv(file, sim.particles(), sim.time());
+      }
+      if (first.empty()) first = file;
+    }
+    ++frames_;
+    last_step_ = sim.step_count();
+    if (on_frame_) on_frame_(first, sim.time());
+  }
+
+  std::vector<scene::OutputFormat> formats_;
   std::filesystem::path dir_;
   io::PvdSeries series_;
+  IntervalSchedule schedule_;
+  std::function<void(const std::filesystem::path&, double)> on_frame_;
   std::size_t frames_ = 0;
+  std::uint64_t last_step_ = 0;
 };
 
-// A CSV file with one row per output time, rewritten atomically after each row
-// so that it always holds every row so far.
-class CsvLog {
+// ---------------------------------------------------------------------------
+// diagnostics.csv: one row per output time (the frames' schedule), rewritten
+// atomically after each row. The run's mechanics first — kinetic, potential
+// (every solver's) and total energy, the relative energy error when every
+// solver conserves energy, momentum and angular momentum (about the origin) —
+// then each solver's own columns, then, for adaptive steps, the step history
+// since the previous row (steps so far, smallest and largest step, the step
+// proposed next and the condition that sets it).
+template <class Real>
+class DiagnosticsLog final : public Observer<Real> {
  public:
-  CsvLog(std::filesystem::path path, std::string header) : path_(std::move(path)), text_(std::move(header) + "\n") {}
+  DiagnosticsLog(const scene::Scene& scene, const RunOptions& options, const Simulation<Real>& sim)
+      : path_(options.out_dir / "diagnostics.csv"), schedule_(scene.output_interval, scene.dt),
+        adaptive_(scene.adaptive_dt), dt_max_(scene.dt), block_size_(scene.block_size) {
+    conservative_ = std::all_of(sim.solvers().begin(), sim.solvers().end(),
+                                [](const auto& s) { return s->conserves_energy(); });
+    std::string header = "time,kinetic_energy,potential_energy,total_energy";
+    if (conservative_) header += ",relative_energy_error";
+    header += ",momentum_x,momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z";
+    for (const auto& s : sim.solvers())
+      for (const auto& c : s->diagnostic_columns()) header += "," + c;
+    if (adaptive_) header += ",step,dt_min,dt_max,dt_next,limited_by";
+    text_ = header + "\n";
+  }
 
-  // Continues an existing log, keeping its first `rows` rows.
-  void resume(std::size_t rows) {
+  std::string_view name() const override { return "diagnostics"; }
+  void on_start(Simulation<Real>& sim, bool resumed) override {
+    if (!resumed) add_row(sim);
+  }
+  void on_step(Simulation<Real>& sim) override {
+    frame_dt_min_ = std::min(frame_dt_min_, sim.last_dt());
+    frame_dt_max_ = std::max(frame_dt_max_, sim.last_dt());
+    if (!schedule_.due(sim.time())) return;
+    add_row(sim);
+    schedule_.acted(sim.time());
+  }
+  void on_finish(Simulation<Real>& sim) override {
+    if (last_step_ != sim.step_count() || rows_ == 0) add_row(sim);
+  }
+  std::optional<double> next_time(const Simulation<Real>&) const override { return schedule_.next_time(); }
+
+  void save_state(NamedValues& out) const override {
+    out.insert(out.end(), {{"diagnostics.rows", double(rows_)},
+                           {"diagnostics.next", double(schedule_.next_index())},
+                           {"diagnostics.last_step", double(last_step_)},
+                           {"diagnostics.initial_energy", initial_energy_},
+                           {"diagnostics.frame_dt_min", frame_dt_min_},
+                           {"diagnostics.frame_dt_max", frame_dt_max_}});
+  }
+  // Continues the log, keeping the rows written before the checkpoint.
+  void load_state(const NamedValues& values) override {
+    rows_ = static_cast<std::size_t>(find_value(values, "diagnostics.rows").value_or(0));
+    schedule_.set_next_index(static_cast<std::uint64_t>(find_value(values, "diagnostics.next").value_or(1)));
+    last_step_ = static_cast<std::uint64_t>(find_value(values, "diagnostics.last_step").value_or(0));
+    initial_energy_ = find_value(values, "diagnostics.initial_energy").value_or(initial_energy_);
+    frame_dt_min_ = find_value(values, "diagnostics.frame_dt_min").value_or(frame_dt_min_);
+    frame_dt_max_ = find_value(values, "diagnostics.frame_dt_max").value_or(0);
     if (!std::filesystem::exists(path_)) return;
     std::istringstream in(io::read_text_file(path_));
     std::string line;
     std::getline(in, line);  // the header, as this version writes it
-    for (std::size_t k = 0; k < rows && std::getline(in, line); ++k) text_ += line + "\n";
+    for (std::size_t k = 0; k < rows_ && std::getline(in, line); ++k) text_ += line + "\n";
   }
-  void add(const std::vector<double>& row, std::string_view last_text_column = {}) {
-    for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
-    if (!last_text_column.empty()) text_ += fmt::format(",{}", last_text_column);
-    text_ += "\n";
-    io::write_file_atomic(path_, text_);
+
+  // The relative energy error at the last row (conservative runs), for the summary.
+  std::optional<double> energy_error() const {
+    if (!conservative_ || rows_ == 0) return std::nullopt;
+    return energy_error_;
   }
 
  private:
+  void add_row(Simulation<Real>& sim) {
+    ScopedPhase phase(sim.timers(), "output");
+    const auto& p = sim.particles();
+    const Mechanics m = mechanics(p);
+    double potential = 0;
+    for (const auto& s : sim.solvers()) potential += s->potential_energy(p, block_size_);
+    const double total = m.kinetic + potential;
+    std::vector<double> row{sim.time(), m.kinetic, potential, total};
+    if (conservative_) {
+      if (std::isnan(initial_energy_)) initial_energy_ = total;
+      energy_error_ = initial_energy_ != 0 ? (total - initial_energy_) / std::abs(initial_energy_) : 0.0;
+      row.push_back(energy_error_);
+    }
+    row.insert(row.end(), {m.momentum[0], m.momentum[1], m.momentum[2], m.angular[0], m.angular[1], m.angular[2]});
+    for (const auto& s : sim.solvers()) s->add_diagnostics(p, block_size_, row);
+    for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
+    if (adaptive_) {
+      const bool stepped = frame_dt_max_ > 0;
+      text_ += fmt::format(",{:.9g},{:.9g},{:.9g},{:.9g},{}", double(sim.step_count()), stepped ? frame_dt_min_ : 0.0,
+                           frame_dt_max_, sim.proposed_dt(), limited_by(sim));
+      frame_dt_min_ = std::numeric_limits<double>::infinity(), frame_dt_max_ = 0;
+    }
+    text_ += "\n";
+    io::write_file_atomic(path_, text_);
+    ++rows_;
+    last_step_ = sim.step_count();
+  }
+
+  // What sets the next adaptive step: a condition, dt_max, or the growth cap.
+  std::string_view limited_by(const Simulation<Real>& sim) const {
+    const auto& tight = sim.tightest();
+    if (sim.proposed_dt() < std::min(tight.dt, dt_max_)) return "growth";
+    return tight.dt <= dt_max_ ? tight.condition : std::string_view("dt_max");
+  }
+
+  struct Mechanics {
+    double kinetic = 0;
+    std::array<double, 3> momentum{}, angular{};
+  };
+  // K = ½ Σ m|v|², P = Σ m v, L = Σ m x × v: in double per block, folded in
+  // block order (the same bits for any thread count).
+  Mechanics mechanics(const ParticleSet<Real>& p) const {
+    using Partial = std::array<double, 7>;
+    const Partial t = parallel::reduce_blocks(
+        "mechanics", p.size(), block_size_, Partial{},
+        [&](std::size_t b, std::size_t e) {
+          Partial s{};
+          for (std::size_t i = b; i < e; ++i) {
+            const double m = p.mass[i];
+            const double x = p.position.x[i], y = p.position.y[i], z = p.position.z[i];
+            const double vx = p.velocity.x[i], vy = p.velocity.y[i], vz = p.velocity.z[i];
+            s[0] += 0.5 * m * (vx * vx + vy * vy + vz * vz);
+            s[1] += m * vx, s[2] += m * vy, s[3] += m * vz;
+            s[4] += m * (y * vz - z * vy), s[5] += m * (z * vx - x * vz), s[6] += m * (x * vy - y * vx);
+          }
+          return s;
+        },
+        [](Partial a, const Partial& b) {
+          for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
+          return a;
+        });
+    return {t[0], {t[1], t[2], t[3]}, {t[4], t[5], t[6]}};
+  }
+
   std::filesystem::path path_;
+  IntervalSchedule schedule_;
+  bool adaptive_;
+  double dt_max_;
+  std::size_t block_size_;
+  bool conservative_ = true;
   std::string text_;
+  std::size_t rows_ = 0;
+  std::uint64_t last_step_ = 0;
+  double initial_energy_ = std::numeric_limits<double>::quiet_NaN();
+  double energy_error_ = 0;
+  double frame_dt_min_ = std::numeric_limits<double>::infinity(), frame_dt_max_ = 0;
 };
 
-template <class Real>
-std::size_t bytes_per_particle(const ParticleSet<Real>& p) {
-  std::size_t bytes = sizeof(std::uint64_t);  // id
-  for (const auto& f : p.fields()) bytes += static_cast<std::size_t>(f.components) * sizeof(Real);
-  return bytes;
-}
-
-// Named values of the run kept in checkpoints (io::CheckpointValues).
-double value_of(const io::CheckpointValues& values, std::string_view name, double fallback) {
-  for (const auto& [n, v] : values)
-    if (n == name) return v;
-  return fallback;
-}
-
-// Steps from t = 0 to time t (the same rounding as Scene::total_steps).
-std::uint64_t steps_until(double t, double dt) {
-  return static_cast<std::uint64_t>(std::max(0.0, std::ceil(t / dt - 1e-9)));
-}
-
+// ---------------------------------------------------------------------------
+// Checkpoints in out_dir/checkpoints/: every N steps and/or every T of
+// simulated time, and when the run is asked to stop. Each holds the particle
+// fields, the simulation's clock and state, and every observer's state.
 std::filesystem::path checkpoint_dir(const std::filesystem::path& out) { return out / "checkpoints"; }
 
 // Checkpoint files, newest (highest step) first.
@@ -129,6 +263,160 @@ std::vector<std::filesystem::path> checkpoints_in(const std::filesystem::path& o
   return files;
 }
 
+void save_clock(const SimulationClock& c, NamedValues& out) {
+  out.insert(out.end(), {{"clock.previous_dt", c.previous_dt}, {"clock.dt_floor", c.dt_floor}});
+}
+
+template <class Real>
+class Checkpointer final : public Observer<Real> {
+ public:
+  using Collect = std::function<void(NamedValues&)>;
+  Checkpointer(const scene::Scene& scene, const RunOptions& options, std::uint64_t scene_hash, Collect collect)
+      : options_(options), schedule_(options.checkpoint_every.value_or(0), scene.dt), hash_(scene_hash),
+        collect_(std::move(collect)) {}
+
+  std::string_view name() const override { return "checkpoints"; }
+  void on_step(Simulation<Real>& sim) override {
+    bool now = options_.checkpoint_every_steps && sim.step_count() % *options_.checkpoint_every_steps == 0;
+    if (schedule_.due(sim.time())) {
+      schedule_.acted(sim.time());
+      now = true;
+    }
+    if (now) write(sim);
+  }
+  void save_state(NamedValues& out) const override {
+    out.emplace_back("checkpoints.next", double(schedule_.next_index()));
+  }
+  void load_state(const NamedValues& values) override {
+    schedule_.set_next_index(static_cast<std::uint64_t>(find_value(values, "checkpoints.next").value_or(1)));
+  }
+
+  // Writes one now (the run calls it when asked to stop), unless one was written at this step.
+  void write(Simulation<Real>& sim) {
+    if (!last_.empty() && last_step_ == sim.step_count()) return;
+    last_step_ = sim.step_count();
+    ScopedPhase phase(sim.timers(), "output");
+    NamedValues values;
+    collect_(values);
+    std::filesystem::create_directories(checkpoint_dir(options_.out_dir));
+    const auto file = checkpoint_dir(options_.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count());
+    io::write_checkpoint(file, sim.particles(),
+                         {sizeof(Real), sim.particles().size(), hash_, sim.step_count(), sim.time()}, values);
+    last_ = file;
+    const auto files = checkpoints_in(options_.out_dir);
+    for (std::size_t k = std::max<std::size_t>(options_.checkpoint_keep, 1); k < files.size(); ++k)
+      std::filesystem::remove(files[k]);
+  }
+  const std::filesystem::path& last() const { return last_; }
+
+ private:
+  const RunOptions& options_;
+  IntervalSchedule schedule_;
+  std::uint64_t hash_;
+  Collect collect_;
+  std::filesystem::path last_;
+  std::uint64_t last_step_ = 0;
+};
+
+// ---------------------------------------------------------------------------
+// OnBlowUp::Warn: each kind of failed check reported the 1st, 10th, 100th, ... time.
+template <class Real>
+class GuardReporter final : public Observer<Real> {
+ public:
+  explicit GuardReporter(std::function<void(const std::string&)> on_warning) : on_warning_(std::move(on_warning)) {}
+  std::string_view name() const override { return "guard"; }
+  void on_step(Simulation<Real>& sim) override {
+    for (const GuardEvent& event : sim.take_events()) {
+      const std::uint64_t n = ++counts_[static_cast<std::size_t>(event.cause)];
+      std::uint64_t decade = 1;
+      while (decade * 10 <= n) decade *= 10;
+      if (n != decade || !on_warning_) continue;
+      on_warning_(n == 1 ? event.message : fmt::format("({} times so far) {}", n, event.message));
+    }
+  }
+  void add_warnings(std::vector<std::string>& out) const {
+    for (std::size_t k = 0; k < counts_.size(); ++k)
+      if (counts_[k] > 0)
+        out.push_back(fmt::format("{} steps failed the '{}' check (--on-blowup=warn)", counts_[k],
+                                  to_string(static_cast<BlowUpCause>(k))));
+  }
+
+ private:
+  std::function<void(const std::string&)> on_warning_;
+  std::array<std::uint64_t, 4> counts_{};
+};
+
+// ---------------------------------------------------------------------------
+// The progress callback, and this invocation's smallest and largest step.
+template <class Real>
+class Progress final : public Observer<Real> {
+ public:
+  using Callback = std::function<void(const RunProgress&)>;
+  using Total = std::function<std::uint64_t()>;
+  Progress(Callback callback, Total total) : callback_(std::move(callback)), total_(std::move(total)) {}
+  std::string_view name() const override { return "progress"; }
+  void on_start(Simulation<Real>& sim, bool) override {
+    started_ = std::chrono::steady_clock::now();
+    report(sim);
+  }
+  void on_step(Simulation<Real>& sim) override {
+    dt_min_ = std::min(dt_min_, sim.last_dt());
+    dt_max_ = std::max(dt_max_, sim.last_dt());
+    report(sim);
+  }
+  double wall() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count(); }
+  double dt_min() const { return dt_min_; }
+  double dt_max() const { return dt_max_; }
+
+ private:
+  void report(const Simulation<Real>& sim) const {
+    if (callback_) callback_({sim.step_count(), total_(), sim.time(), wall()});
+  }
+  Callback callback_;
+  Total total_;
+  std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  double dt_min_ = std::numeric_limits<double>::infinity(), dt_max_ = 0;
+};
+
+// ---------------------------------------------------------------------------
+template <class Real>
+std::size_t bytes_per_particle(const Simulation<Real>& sim) {
+  const auto& p = sim.particles();
+  std::size_t bytes = sizeof(std::uint64_t);  // id
+  for (const auto& f : p.fields()) bytes += static_cast<std::size_t>(f.components) * sizeof(Real);
+  if (p.empty()) return bytes;
+  std::size_t scratch = sim.order().bytes();
+  for (const auto& s : sim.solvers()) scratch += s->scratch_bytes();
+  return bytes + scratch / p.size();
+}
+
+// Steps from t = 0 to time t (the same rounding as Scene::total_steps).
+std::uint64_t steps_until(double t, double dt) {
+  return static_cast<std::uint64_t>(std::max(0.0, std::ceil(t / dt - 1e-9)));
+}
+
+// Reads the newest valid checkpoint of this scene into sim and returns its
+// header and values; warnings name the files skipped.
+template <class Real>
+std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<Real>& sim, const RunOptions& options,
+                                                                    std::uint64_t hash, RunSummary& summary) {
+  for (const auto& file : checkpoints_in(options.out_dir)) {
+    try {
+      NamedValues values;
+      const auto h = io::read_checkpoint(file, sim.particles(), values);
+      if (h.scene_hash != hash)
+        throw io::IoError(fmt::format("{}: belongs to another scene (hash {:016x}, the scene's is {:016x})",
+                                      file.string(), h.scene_hash, hash));
+      summary.last_checkpoint = file;
+      return {h, std::move(values)};
+    } catch (const io::IoError& e) {
+      summary.warnings.push_back(fmt::format("skipping checkpoint: {}", e.what()));
+    }
+  }
+  throw io::IoError(fmt::format("{}: no valid checkpoint to resume from{}", checkpoint_dir(options.out_dir).string(),
+                                summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
+}
+
 template <class Real>
 RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::uintmax_t first_output_bytes,
                      const std::function<void(const RunProgress&)>& on_progress) {
@@ -139,223 +427,76 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   summary.threads = parallel::thread_count();
   const std::uint64_t hash = scene::scene_hash(scene);
 
-  auto built = build_simulation<Real>(scene);
+  Simulation<Real> sim = build_simulation<Real>(scene);
   // Only now, so that a scene refused while its particles are built leaves no
   // empty output directory behind; nothing has been run yet.
   io::ensure_writable_directory(options.out_dir, first_output_bytes);
-  Simulation<Real>& sim = built.sim;
-  const sph::SphFluid<Real>* fluid = built.fluid;
-  const gravity::GravityForce<Real>* self_gravity = built.self_gravity;
   sim.set_on_blow_up(options.on_blow_up);
-  const bool adaptive = scene.adaptive_dt;
-  // Adaptive runs log their step history per frame (run.hpp), after the solver's columns.
-  const std::string step_columns = adaptive ? ",step,dt_min,dt_max,dt_next,limited_by" : "";
-  std::optional<CsvLog> diagnostics;
-  if (fluid)
-    diagnostics.emplace(options.out_dir / "diagnostics.csv",
-                        "time,kinetic_energy,potential_energy,momentum_x,momentum_y,momentum_z,"
-                        "mean_density_error,max_density_error,mean_neighbours" + step_columns);
-  else if (self_gravity)
-    diagnostics.emplace(options.out_dir / "diagnostics.csv",
-                        "time,kinetic_energy,potential_energy,total_energy,relative_energy_error,momentum_x,"
-                        "momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z,virial_ratio,"
-                        "mean_nodes_visited" + step_columns);
-  else if (adaptive)
-    diagnostics.emplace(options.out_dir / "diagnostics.csv", "time" + step_columns);
+  sim.prepare();  // every field declared, so a checkpoint's fields meet their uses
   summary.particles = sim.particles().size();
 
-  // Run state that must survive a restart, saved in every checkpoint.
-  FrameWriter<Real> writer(scene, options.out_dir);
-  double initial_energy = std::numeric_limits<double>::quiet_NaN();  // gravity runs: E at t = 0
-  double energy_error = 0;
-  double neighbor_sum = 0, nodes_sum = 0;  // per-evaluation means, summed for the summary
-  std::uint64_t next_frame = 1, last_frame_step = 0, next_checkpoint = 1;
-  // Adaptive steps: the smallest and largest step since the last frame.
-  double frame_dt_min = std::numeric_limits<double>::infinity(), frame_dt_max = 0;
-  double run_dt_min = std::numeric_limits<double>::infinity(), run_dt_max = 0;  // this invocation's, for the summary
-
-  if (options.resume) {
-    io::CheckpointValues values;
-    std::optional<io::CheckpointHeader> header;
-    for (const auto& file : checkpoints_in(options.out_dir)) {
-      try {
-        const auto h = io::read_checkpoint(file, sim.particles(), values);
-        if (h.scene_hash != hash)
-          throw io::IoError(fmt::format("{}: belongs to another scene (hash {:016x}, the scene's is {:016x})",
-                                        file.string(), h.scene_hash, hash));
-        header = h;
-        summary.last_checkpoint = file;
-        break;
-      } catch (const io::IoError& e) {
-        summary.warnings.push_back(fmt::format("skipping checkpoint: {}", e.what()));
-      }
-    }
-    if (!header)
-      throw io::IoError(fmt::format("{}: no valid checkpoint to resume from{}", checkpoint_dir(options.out_dir).string(),
-                                    summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
-    if (adaptive) {
-      // The controller's state; without it the resumed steps would differ.
-      const double previous = value_of(values, "dt_previous", -1), floor = value_of(values, "dt_floor", -1);
-      if (previous < 0 || floor < 0)
-        throw io::IoError(fmt::format("{}: has no adaptive time-step state (dt_previous, dt_floor): not written by an "
-                                      "adaptive run of this swirl", summary.last_checkpoint.string()));
-      sim.resume(header->step, header->time, previous, floor);
-      frame_dt_min = value_of(values, "frame_dt_min", frame_dt_min);
-      frame_dt_max = value_of(values, "frame_dt_max", 0);
-    } else {
-      sim.resume(header->step);
-    }
-    summary.first_step = header->step;
-    const auto frames = static_cast<std::size_t>(value_of(values, "frames", 0));
-    writer.resume(frames);
-    if (diagnostics) diagnostics->resume(frames);  // one row per frame
-    next_frame = static_cast<std::uint64_t>(value_of(values, "next_frame", 1));
-    last_frame_step = static_cast<std::uint64_t>(value_of(values, "last_frame_step", 0));
-    next_checkpoint = static_cast<std::uint64_t>(value_of(values, "next_checkpoint", 1));
-    initial_energy = value_of(values, "initial_energy", initial_energy);
-    neighbor_sum = value_of(values, "neighbor_sum", 0);
-    nodes_sum = value_of(values, "nodes_sum", 0);
-  } else {
-    io::write_file_atomic(options.out_dir / "scene.toml", scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
-  }
-
+  // Where the run ends: a step count, or (adaptive steps) a time landed on exactly.
   std::uint64_t target = scene.total_steps();
-  if (options.until) target = steps_until(*options.until, scene.dt);
-  if (options.steps) target = summary.first_step + *options.steps;
-  // Adaptive steps run to a time (landing on it exactly) unless a step count is asked for.
+  const bool adaptive = scene.adaptive_dt;
   const bool to_time = adaptive && !options.steps && (options.until || scene.end_time);
   const double end_time = to_time ? options.until.value_or(scene.end_time.value_or(0.0)) : 0.0;
-  auto running = [&] { return to_time ? sim.time() < end_time : sim.step_count() < target; };
-  // Progress of an adaptive run counts the steps still to go at the current step size.
-  auto total_steps = [&] {
+  auto total_steps = [&]() -> std::uint64_t {
     if (!to_time) return target;
+    // An estimate: the steps still to go at the current step size.
     const double left = std::max(0.0, (end_time - sim.time()) / sim.proposed_dt());
     return sim.step_count() + static_cast<std::uint64_t>(std::min(std::ceil(left), 1e18));
   };
 
-  const auto started = std::chrono::steady_clock::now();
-  auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(); };
-  // Appends the step history (adaptive runs) and writes the row.
-  auto add_diagnostics = [&](std::vector<double>& row) {
-    if (!adaptive) return diagnostics->add(row);
-    const bool stepped = frame_dt_max > 0;
-    row.insert(row.end(), {double(sim.step_count()), stepped ? frame_dt_min : 0.0, frame_dt_max, sim.proposed_dt()});
-    const auto& tight = sim.limits().tightest();
-    const std::string_view by = sim.proposed_dt() < std::min(tight.dt, scene.dt) ? std::string_view("growth")
-                                : tight.dt <= scene.dt                            ? tight.condition
-                                                                                  : std::string_view("dt_max");
-    diagnostics->add(row, by);
-    frame_dt_min = std::numeric_limits<double>::infinity(), frame_dt_max = 0;
+  // The observers, in the order they act after a step.
+  auto frames = std::make_unique<FrameWriter<Real>>(scene, options);
+  auto diagnostics = std::make_unique<DiagnosticsLog<Real>>(scene, options, sim);
+  auto guard = std::make_unique<GuardReporter<Real>>(options.on_warning);
+  auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps);
+  std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get(), guard.get()};
+  auto collect = [&](NamedValues& values) {
+    save_clock(sim.clock(), values);
+    sim.save_state(values);
+    for (const Observer<Real>* o : observers) o->save_state(values);
   };
-  auto write_frame = [&] {
-    ScopedPhase phase(sim.timers(), "output");
-    const auto frame_file = writer.write(sim.particles(), sim.time());
-    last_frame_step = sim.step_count();
-    if (options.on_frame) options.on_frame(frame_file, sim.time());
-    if (fluid) {
-      const auto d = sph::fluid_diagnostics(sim.particles(), scene.gravity, scene.sph->rest_density, scene.block_size);
-      auto row = std::vector<double>{sim.time(), d.kinetic_energy, d.potential_energy, d.momentum.x, d.momentum.y,
-                                     d.momentum.z, d.mean_density_error, d.max_density_error, fluid->mean_neighbors()};
-      add_diagnostics(row);
-    } else if (self_gravity) {
-      const auto d = gravity::diagnose(sim.particles(), scene.block_size);
-      if (std::isnan(initial_energy)) initial_energy = d.total;
-      energy_error = initial_energy != 0 ? (d.total - initial_energy) / std::abs(initial_energy) : 0.0;
-      auto row = std::vector<double>{sim.time(), d.kinetic, d.potential, d.total, energy_error, d.momentum.x,
-                                     d.momentum.y, d.momentum.z, d.angular_momentum.x, d.angular_momentum.y,
-                                     d.angular_momentum.z, d.virial_ratio, self_gravity->stats().mean_nodes_visited};
-      add_diagnostics(row);
-    } else if (adaptive) {
-      auto row = std::vector<double>{sim.time()};
-      add_diagnostics(row);
-    }
-  };
-  auto write_checkpoint = [&] {
-    ScopedPhase phase(sim.timers(), "output");
-    io::CheckpointValues values{{"frames", double(writer.frames())},
-                                {"next_frame", double(next_frame)},
-                                {"last_frame_step", double(last_frame_step)},
-                                {"next_checkpoint", double(next_checkpoint)},
-                                {"initial_energy", initial_energy},
-                                {"neighbor_sum", neighbor_sum},
-                                {"nodes_sum", nodes_sum}};
-    if (adaptive)
-      values.insert(values.end(), {{"dt_previous", sim.previous_dt()},
-                                   {"dt_floor", sim.dt_floor()},
-                                   {"frame_dt_min", frame_dt_min},
-                                   {"frame_dt_max", frame_dt_max}});
-    std::filesystem::create_directories(checkpoint_dir(options.out_dir));
-    const auto file = checkpoint_dir(options.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count());
-    io::write_checkpoint(file, sim.particles(), {sizeof(Real), sim.particles().size(), hash, sim.step_count(), sim.time()},
-                         values);
-    summary.last_checkpoint = file;
-    const auto files = checkpoints_in(options.out_dir);
-    for (std::size_t k = std::max<std::size_t>(options.checkpoint_keep, 1); k < files.size(); ++k)
-      std::filesystem::remove(files[k]);
-  };
+  auto checkpoints = std::make_unique<Checkpointer<Real>>(scene, options, hash, collect);
+  observers.push_back(checkpoints.get());
+  observers.push_back(progress.get());
 
-  // OnBlowUp::Warn: each kind of failed check is reported the 1st, 10th, 100th, ... time.
-  std::vector<std::uint64_t> warned(4, 0);
-  auto warn = [&](const GuardEvent& event) {
-    const std::uint64_t n = ++warned[static_cast<std::size_t>(event.cause)];
-    std::uint64_t decade = 1;
-    while (decade * 10 <= n) decade *= 10;
-    if (n != decade) return;
-    const std::string text = n == 1 ? event.message : fmt::format("({} times so far) {}", n, event.message);
-    if (options.on_warning) options.on_warning(text);
-  };
-  // Frame k is due at the first step with time ≥ k·interval; the slack keeps
-  // k·interval that lands on a step (up to rounding) on that step. Checkpoints
-  // by time follow the same rule. Adaptive steps land on k·interval exactly.
-  const double interval = scene.output_interval;
-  const double slack = 1e-9 * scene.dt;
-  auto due = [&](double every, std::uint64_t k) { return sim.time() + slack >= static_cast<double>(k) * every; };
-  auto after = [&](double every) { return static_cast<std::uint64_t>(std::floor((sim.time() + slack) / every)) + 1; };
+  if (options.resume) {
+    const auto [header, values] = read_newest_checkpoint(sim, options, hash, summary);
+    SimulationClock clock{header.step, header.time, find_value(values, "clock.previous_dt").value_or(0),
+                          find_value(values, "clock.dt_floor").value_or(0)};
+    sim.resume(clock, values);
+    for (Observer<Real>* o : observers) o->load_state(values);
+    summary.first_step = header.step;
+  } else {
+    io::write_file_atomic(options.out_dir / "scene.toml", scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
+  }
+  if (options.until) target = steps_until(*options.until, scene.dt);
+  if (options.steps) target = summary.first_step + *options.steps;
+  auto running = [&] { return to_time ? sim.time() < end_time : sim.step_count() < target; };
+
   try {
-    if (!options.resume) {
-      sim.start();  // force models add their fields (density, potential) here
-      write_frame();
-    }
-    summary.bytes_per_particle = bytes_per_particle(sim.particles());
-    if (on_progress) on_progress({sim.step_count(), total_steps(), sim.time(), wall()});
+    if (!options.resume) sim.start();  // solvers fill their fields (density, potential) here
+    summary.bytes_per_particle = bytes_per_particle(sim);
+    for (Observer<Real>* o : observers) o->on_start(sim, options.resume);
     while (running()) {
-      if (adaptive) {
-        // Land exactly on the next output time and on the end time.
-        std::optional<double> land;
+      std::optional<double> land;
+      if (adaptive) {  // land exactly on the end time and on the observers' next times
         if (to_time) land = end_time;
-        if (interval > 0) {
-          const double frame_time = static_cast<double>(next_frame) * interval;
-          if (!land || frame_time < *land) land = frame_time;
-        }
-        sim.step(land);
-        frame_dt_min = std::min(frame_dt_min, sim.last_dt());
-        frame_dt_max = std::max(frame_dt_max, sim.last_dt());
-        run_dt_min = std::min(run_dt_min, sim.last_dt());
-        run_dt_max = std::max(run_dt_max, sim.last_dt());
-      } else {
-        sim.step();
+        for (const Observer<Real>* o : observers)
+          if (const auto t = o->next_time(sim); t && (!land || *t < *land)) land = t;
       }
-      for (auto& event : sim.take_events()) warn(event);
-      if (fluid) neighbor_sum += fluid->mean_neighbors();
-      if (self_gravity) nodes_sum += self_gravity->stats().mean_nodes_visited;
-      if (interval > 0 && due(interval, next_frame)) {
-        write_frame();
-        next_frame = after(interval);
-      }
-      bool checkpoint = options.checkpoint_every_steps && sim.step_count() % *options.checkpoint_every_steps == 0;
-      if (options.checkpoint_every && due(*options.checkpoint_every, next_checkpoint)) {
-        next_checkpoint = after(*options.checkpoint_every);
-        checkpoint = true;
-      }
-      const bool stopping = options.stop && options.stop->load();
-      if (checkpoint || stopping) write_checkpoint();
-      if (on_progress) on_progress({sim.step_count(), total_steps(), sim.time(), wall()});
-      if (stopping) {
+      sim.step(land);
+      for (Observer<Real>* o : observers) o->on_step(sim);
+      if (options.stop && options.stop->load()) {
+        checkpoints->write(sim);
         summary.interrupted = true;
         break;
       }
     }
-    if (!summary.interrupted && last_frame_step != sim.step_count()) write_frame();
+    if (!summary.interrupted)
+      for (Observer<Real>* o : observers) o->on_finish(sim);
   } catch (const SimulationError& e) {
     summary.error = e.what();
     summary.blow_up = std::string(to_string(e.cause()));
@@ -365,32 +506,20 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
   }
 
-  for (std::size_t k = 0; k < warned.size(); ++k)
-    if (warned[k] > 0)
-      summary.warnings.push_back(fmt::format("{} steps failed the '{}' check (--on-blowup=warn)", warned[k],
-                                             to_string(static_cast<BlowUpCause>(k))));
+  guard->add_warnings(summary.warnings);
+  if (!checkpoints->last().empty()) summary.last_checkpoint = checkpoints->last();
   summary.steps = sim.step_count() - summary.first_step;
   summary.sim_time = sim.time();
-  summary.wall_seconds = wall();
+  summary.wall_seconds = progress->wall();
   summary.steps_per_second = summary.wall_seconds > 0 ? static_cast<double>(summary.steps) / summary.wall_seconds : 0;
   summary.phases = sim.timers().phases();
-  summary.frames = writer.frames();
-  if (fluid && !sim.particles().empty())  // SPH search structures, lists and reorder scratch
-    summary.bytes_per_particle += fluid->scratch_bytes() / sim.particles().size();
-  const double evaluations = static_cast<double>(sim.step_count());
-  if (fluid)
-    summary.metrics.emplace_back("mean_neighbours", evaluations > 0 ? neighbor_sum / evaluations : fluid->mean_neighbors());
-  if (adaptive && run_dt_max > 0) {  // landing steps included
-    summary.metrics.emplace_back("smallest_dt", run_dt_min);
-    summary.metrics.emplace_back("largest_dt", run_dt_max);
-  }
-  if (self_gravity) {
-    summary.metrics.emplace_back("relative_energy_error", energy_error);  // at the last frame
-    summary.metrics.emplace_back("mean_nodes_visited",
-                                 evaluations > 0 ? nodes_sum / evaluations : self_gravity->stats().mean_nodes_visited);
-    if (self_gravity->stats().tree_bytes > 0 && summary.particles > 0)
-      summary.metrics.emplace_back("tree_bytes_per_particle",
-                                   double(self_gravity->stats().tree_bytes) / double(summary.particles));
+  summary.frames = frames->frames();
+  for (const auto& s : sim.solvers()) s->add_metrics(summary.metrics);
+  if (const auto error = diagnostics->energy_error()) summary.metrics.emplace_back("relative_energy_error", *error);
+  if (sim.order().active()) summary.metrics.emplace_back("sorts", double(sim.order().sorts()));
+  if (adaptive && progress->dt_max() > 0) {  // landing steps included
+    summary.metrics.emplace_back("smallest_dt", progress->dt_min());
+    summary.metrics.emplace_back("largest_dt", progress->dt_max());
   }
   return summary;
 }

@@ -74,7 +74,7 @@ double momentum_drift(const ParticleSet<Real>& initial, const GravitySettings& g
   ss.dt = dt;
   ss.block_size = 128;
   Simulation<Real> sim(initial, ss);
-  sim.add_force(std::make_unique<GravityForce<Real>>(g));
+  sim.add_solver(std::make_unique<GravityForce<Real>>(g));
   sim.start();
   const Vec3d p0 = momentum(sim.particles());
   double drift = 0;

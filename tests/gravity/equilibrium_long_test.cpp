@@ -67,7 +67,7 @@ TYPED_TEST(EquilibriumTest, PlummerSphereStaysInEquilibriumForTenCrossingTimes) 
     s.dt = dt;
     s.block_size = 256;
     Simulation<Real> sim(plummer<Real>(2048, 2024), s);
-    sim.add_force(std::make_unique<GravityForce<Real>>(g));
+    sim.add_solver(std::make_unique<GravityForce<Real>>(g));
     sim.start();
     const Diagnostics d0 = diagnose(sim.particles());
     const double r0 = half_mass_radius(sim.particles(), d0.centre_of_mass);

@@ -10,7 +10,7 @@
 #include <memory>
 
 #include "gravity/gravity_test_util.hpp"
-#include "swirl/force/force_model.hpp"
+#include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sim/simulation.hpp"
 
@@ -19,11 +19,11 @@ namespace {
 
 // a = −ω²·x on every axis.
 template <class Real>
-class Spring final : public ForceModel<Real> {
+class Spring final : public Solver<Real> {
  public:
   explicit Spring(Real omega) : omega2_(omega * omega) {}
   std::string_view name() const override { return "spring"; }
-  void add_acceleration(ParticleSet<Real>& p, const ForceContext& ctx) override {
+  void add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) override {
     parallel::for_blocks("spring", p.size(), ctx.block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       for (int a = 0; a < 3; ++a)
         for (std::size_t i = b; i < e; ++i) p.acceleration[a][i] += -omega2_ * p.position[a][i];
@@ -55,7 +55,7 @@ TYPED_TEST(LeapfrogTest, ConservesTheModifiedEnergyOfAHarmonicOscillator) {
   SimulationSettings s;
   s.dt = h;
   Simulation<Real> sim(std::move(p), s);
-  sim.add_force(std::make_unique<Spring<Real>>(Real(omega)));
+  sim.add_solver(std::make_unique<Spring<Real>>(Real(omega)));
   sim.start();
   const double w2 = omega * omega, shrink = 1 - w2 * h * h / 4;
   // Per particle: H and E = v² + ω²x² summed over the axes.

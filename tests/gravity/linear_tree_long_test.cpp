@@ -46,7 +46,7 @@ Outcome run(const GravitySettings& g) {
   s.dt = dt;
   s.block_size = 256;
   Simulation<Real> sim(plummer<Real>(2048, 2024), s);
-  sim.add_force(std::make_unique<GravityForce<Real>>(g));
+  sim.add_solver(std::make_unique<GravityForce<Real>>(g));
   sim.start();
   const Diagnostics d0 = diagnose(sim.particles());
   Outcome o;

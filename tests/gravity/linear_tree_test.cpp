@@ -294,9 +294,9 @@ TYPED_TEST(LinearTreeTest, BitIdenticalForOneTwoAndThreeThreads) {
     // Through the force model, reordering the particles along the curve.
     ParticleSet<Real> q = p;
     GravityForce<Real> force{GravitySettings{}};
-    const ForceContext ctx{0, 256, nullptr};
-    force.add_acceleration(q, ctx);
-    force.add_acceleration(q, ctx);
+    spatial::ParticleOrder<Real> order;
+    swirl::evaluate_alone(force, q, order, 256);
+    swirl::evaluate_alone(force, q, order, 256);
     reordered.push_back(std::move(q));
   }
   parallel::set_thread_count(saved);
@@ -312,7 +312,7 @@ TYPED_TEST(LinearTreeTest, BitIdenticalForOneTwoAndThreeThreads) {
   }
 }
 
-TYPED_TEST(LinearTreeTest, ForceModelReordersAlongTheCurveAndIdsSurvive) {
+TYPED_TEST(LinearTreeTest, TheSolverViewsTheSharedOrderAndIdsSurvive) {
   using Real = TypeParam;
   const ParticleSet<Real> p = plummer<Real>(3000, 5);
   GravitySettings g;  // the default: global scheme, linear tree, quadrupole, Barnes' rule
@@ -321,10 +321,10 @@ TYPED_TEST(LinearTreeTest, ForceModelReordersAlongTheCurveAndIdsSurvive) {
   BarnesHut<Real> still(g);
   GravityField<Real> expected;
   still.compute(p, expected, 128);
-  // ...is the force model's, found by id after it reordered them.
+  // ...is the solver's, found by id after the shared order moved them along the curve.
   ParticleSet<Real> q = p;
   GravityForce<Real> force(g);
-  force.add_acceleration(q, ForceContext{0, 128, nullptr});
+  swirl::evaluate_alone(force, q, 128);
   EXPECT_GT(force.stats().tree_bytes, 0u);
   EXPECT_GT(force.stats().mean_interactions, 0.0);
   bool moved = false;

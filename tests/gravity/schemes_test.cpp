@@ -168,7 +168,7 @@ ParticleSet<Real> run_steps(Scheme scheme, bool small, int threads) {
   ss.dt = 1.0 / 128;
   ss.block_size = 256;
   Simulation<Real> sim(plummer<Real>(3000, 21), ss);
-  sim.add_force(std::make_unique<GravityForce<Real>>(settings(scheme, 0.5, 0.01, small)));
+  sim.add_solver(std::make_unique<GravityForce<Real>>(settings(scheme, 0.5, 0.01, small)));
   sim.start();
   // Several evaluations, so that the sub-domain load balance uses the work
   // counted in the previous one (section 4.1.1).

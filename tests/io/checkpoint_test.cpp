@@ -110,7 +110,7 @@ TYPED_TEST(CheckpointTest, DamageIsRefusedWithAReason) {
   std::string old = good;
   const std::uint32_t zero = 0;
   std::memcpy(old.data() + 8, &zero, 4);
-  expect_refused<Real>(old, "format version 0 is not supported: this swirl reads version 1 only (written by an older swirl)");
+  expect_refused<Real>(old, "format version 0 is not supported: this swirl reads version 2 only (written by an older swirl)");
   // The other precision is refused, not misread.
   if constexpr (std::is_same_v<Real, float>) {
     ParticleSet<double> d;

@@ -81,9 +81,9 @@ TEST(CheckpointFuzzRegressions, SeedsAreReadOrRefusedAsExpected) {
     EXPECT_EQ(replay_checkpoint_as<float>(bytes).has_value(), broken || !is_float) << name;
     EXPECT_EQ(replay_checkpoint_as<double>(bytes).has_value(), broken || is_float) << name;
   }
-  const auto refusal = replay_checkpoint_as<double>(file_bytes(kFuzzDir / "corpus" / "checkpoint" / "version2.ckp"));
+  const auto refusal = replay_checkpoint_as<double>(file_bytes(kFuzzDir / "corpus" / "checkpoint" / "version3.ckp"));
   ASSERT_TRUE(refusal.has_value());
-  EXPECT_NE(refusal->find("version 2"), std::string::npos) << *refusal;
+  EXPECT_NE(refusal->find("version 3"), std::string::npos) << *refusal;
 }
 
 }  // namespace

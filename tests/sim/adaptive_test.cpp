@@ -41,10 +41,10 @@ Simulation<Real> springy(std::size_t n, double eta = 0.5, double dt_max = 0.05) 
   s.adaptive = true;
   s.block_size = 64;
   s.box = swirl::boundary::BoxCollision<double>{{{0, 0, 0}, {1, 1, 1}}, 0.7};
-  s.limits.gravity = swirl::sim::GravityStepLimits{0.01, eta};
   Simulation<Real> sim(std::move(p), s);
-  sim.add_force(std::make_unique<swirl::testing::Spring<Real>>(Real(6), Real(0.5)));
-  sim.add_force(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
+  sim.add_solver(swirl::testing::gravity_conditions<Real>(0.01, eta));
+  sim.add_solver(std::make_unique<swirl::testing::Spring<Real>>(Real(6), Real(0.5)));
+  sim.add_solver(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
   return sim;
 }
 
@@ -64,7 +64,7 @@ TYPED_TEST(AdaptiveTest, TheStepIsTheTightestLimitCappedByGrowthAndDtMax) {
   sim.start();
   double previous = 0;
   for (int s = 0; s < 50; ++s) {
-    double expected = std::min(sim.limits().gravity.dt, 0.05);
+    double expected = std::min(swirl::testing::limit_named(sim, "gravity").dt, 0.05);
     if (previous > 0) expected = std::min(expected, 1.25 * previous);
     ASSERT_EQ(sim.proposed_dt(), expected) << s;
     const double t0 = sim.time();
@@ -83,7 +83,7 @@ TYPED_TEST(AdaptiveTest, WithoutConditionsTheStepIsDtMax) {
   s.dt = 0.125;
   s.adaptive = true;
   Simulation<Real> sim(std::move(p), s);
-  sim.add_force(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-1)}));
+  sim.add_solver(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-1)}));
   sim.start();
   for (int k = 0; k < 4; ++k) sim.step();
   EXPECT_EQ(sim.time(), 0.5);
@@ -101,7 +101,7 @@ TYPED_TEST(AdaptiveTest, StepsLandExactlyOnRequestedTimes) {
     while (sim.time() < target) {
       const double before = sim.time();
       sim.step(target);
-      ASSERT_LE(sim.last_dt(), sim.previous_dt() * (1 + 1e-9));  // never longer than the choice (but for rounding)
+      ASSERT_LE(sim.last_dt(), sim.clock().previous_dt * (1 + 1e-9));  // never longer than the choice (but for rounding)
       ASSERT_GT(sim.time(), before);
       ASSERT_LT(++steps, 10000);
     }
@@ -123,9 +123,9 @@ TYPED_TEST(AdaptiveTest, VariableStepVerletIsSecondOrder) {
     SimulationSettings s;
     s.dt = eta;  // the cap scales with η too
     s.adaptive = true;
-    s.limits.gravity = swirl::sim::GravityStepLimits{0.05, eta};
     Simulation<Real> sim(std::move(p), s);
-    sim.add_force(std::make_unique<swirl::testing::Spring<Real>>(1.0, 0.0));
+    sim.add_solver(swirl::testing::gravity_conditions<Real>(0.05, eta));
+    sim.add_solver(std::make_unique<swirl::testing::Spring<Real>>(1.0, 0.0));
     sim.start();
     const double period = 2 * M_PI;
     while (sim.time() < period) sim.step(period);
@@ -166,7 +166,9 @@ TYPED_TEST(AdaptiveTest, ResumingMidRunIsBitIdentical) {
   for (int s = 0; s < 30; ++s) first.step(0.5);
   auto second = springy<Real>(500);
   second.particles() = first.particles();
-  second.resume(first.step_count(), first.time(), first.previous_dt(), first.dt_floor());
+  swirl::NamedValues state;
+  first.save_state(state);
+  second.resume(first.clock(), state);
   for (int s = 0; s < 40; ++s) second.step(0.5);
 
   EXPECT_TRUE(bit_identical(straight.particles(), second.particles()));
@@ -178,10 +180,10 @@ TYPED_TEST(AdaptiveTest, ResumingMidRunIsBitIdentical) {
 // collapse before the step is taken, naming the particle that sets it.
 TYPED_TEST(AdaptiveTest, ACollapsingStepIsABlowUp) {
   using Real = TypeParam;
-  class Runaway final : public swirl::ForceModel<Real> {
+  class Runaway final : public swirl::Solver<Real> {
    public:
     std::string_view name() const override { return "runaway"; }
-    void add_acceleration(ParticleSet<Real>& p, const swirl::ForceContext&) override {
+    void add_acceleration(ParticleSet<Real>& p, const swirl::SolverContext<Real>&) override {
       scale_ *= 100;
       p.acceleration.x[1] += Real(scale_);
     }
@@ -192,9 +194,9 @@ TYPED_TEST(AdaptiveTest, ACollapsingStepIsABlowUp) {
   SimulationSettings s;
   s.dt = 0.1;
   s.adaptive = true;
-  s.limits.gravity = swirl::sim::GravityStepLimits{0.01, 0.5};
   Simulation<Real> sim(std::move(p), s);
-  sim.add_force(std::make_unique<Runaway>());
+  sim.add_solver(swirl::testing::gravity_conditions<Real>(0.01, 0.5));
+  sim.add_solver(std::make_unique<Runaway>());
   sim.start();
   try {
     for (int k = 0; k < 20; ++k) sim.step();

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <array>
 #include <limits>
 #include <memory>
 #include <string>
@@ -29,11 +30,11 @@ TYPED_TEST_SUITE(GuardTest, Precisions);
 // Writes a NaN into one particle's density when the forces are evaluated at
 // time `when` or later (a solver going wrong).
 template <class Real>
-class Poison final : public swirl::ForceModel<Real> {
+class Poison final : public swirl::Solver<Real> {
  public:
   Poison(std::size_t index, double when) : index_(index), when_(when) {}
   std::string_view name() const override { return "poison"; }
-  void add_acceleration(ParticleSet<Real>& p, const swirl::ForceContext& ctx) override {
+  void add_acceleration(ParticleSet<Real>& p, const swirl::SolverContext<Real>& ctx) override {
     if (ctx.time >= when_) p.density[index_] = std::numeric_limits<Real>::quiet_NaN();
   }
 
@@ -81,7 +82,7 @@ void expect_mentions(const std::string& message, std::initializer_list<std::stri
 TYPED_TEST(GuardTest, ANaNInjectedIntoAFieldStopsTheRunNamingTheQuantity) {
   using Real = TypeParam;
   Simulation<Real> sim(particles<Real>(50), boxed(0.01));
-  sim.add_force(std::make_unique<Poison<Real>>(17, 0.035));  // the 4th step's forces
+  sim.add_solver(std::make_unique<Poison<Real>>(17, 0.035));  // the 4th step's forces
   sim.start();
   const auto [message, cause] = error_of(sim, 10);
   ASSERT_FALSE(message.empty());
@@ -95,7 +96,7 @@ TYPED_TEST(GuardTest, ANaNStopsTheRunEvenWhenWarningOnly) {
   auto settings = boxed(0.01);
   settings.on_blow_up = OnBlowUp::Warn;
   Simulation<Real> sim(particles<Real>(20), settings);
-  sim.add_force(std::make_unique<Poison<Real>>(3, 0.0));
+  sim.add_solver(std::make_unique<Poison<Real>>(3, 0.0));
   sim.start();
   EXPECT_EQ(error_of(sim, 3).second, BlowUpCause::NonFinite);
 }
@@ -107,9 +108,9 @@ TYPED_TEST(GuardTest, ATooLargeStepViolatesTheCflConditionNamingTheFastestPartic
   auto p = particles<Real>(64);
   p.velocity.x[40] = Real(3);  // the fastest: id 140
   auto settings = boxed(0.004);
-  settings.limits.sph = swirl::sim::SphStepLimits{0.02, 10.0, 0.0};  // h, c, no viscosity
   // 0.6·0.02/(10 + 3) = 9.2e-4 < 0.004
   Simulation<Real> sim(std::move(p), settings);
+  sim.add_solver(swirl::testing::sph_conditions<Real>(0.02, 10.0, 0.0));
   sim.start();
   const auto [message, cause] = error_of(sim, 5);
   ASSERT_FALSE(message.empty());
@@ -122,9 +123,9 @@ TYPED_TEST(GuardTest, TheForceViscousAndGravityConditionsAreNamedToo) {
   using Real = TypeParam;
   {  // force: a strong spring (|a| up to 1100, so 0.4·sqrt(0.02/1100) = 1.7e-3), a step too short for the CFL to bind
     auto settings = boxed(0.003);
-    settings.limits.sph = swirl::sim::SphStepLimits{0.02, 0.1, 0.0};
     Simulation<Real> sim(particles<Real>(30), settings);
-    sim.add_force(std::make_unique<swirl::testing::Spring<Real>>(Real(40), Real(0.5)));
+    sim.add_solver(swirl::testing::sph_conditions<Real>(0.02, 0.1, 0.0));
+    sim.add_solver(std::make_unique<swirl::testing::Spring<Real>>(Real(40), Real(0.5)));
     sim.start();
     const auto [message, cause] = error_of(sim, 1);
     EXPECT_EQ(cause, BlowUpCause::TimeStep);
@@ -132,8 +133,8 @@ TYPED_TEST(GuardTest, TheForceViscousAndGravityConditionsAreNamedToo) {
   }
   {  // viscous: 0.125·0.02²·1000/μ with μ = 100 is 5e-4
     auto settings = boxed(0.001);
-    settings.limits.sph = swirl::sim::SphStepLimits{0.02, 0.1, 100.0};
     Simulation<Real> sim(particles<Real>(30), settings);
+    sim.add_solver(swirl::testing::sph_conditions<Real>(0.02, 0.1, 100.0));
     sim.start();
     const auto [message, cause] = error_of(sim, 1);
     EXPECT_EQ(cause, BlowUpCause::TimeStep);
@@ -142,9 +143,9 @@ TYPED_TEST(GuardTest, TheForceViscousAndGravityConditionsAreNamedToo) {
   {  // gravity, softened
     auto settings = boxed(0.05);
     settings.box.reset();
-    settings.limits.gravity = swirl::sim::GravityStepLimits{0.01, 0.5};
     Simulation<Real> sim(particles<Real>(30), settings);
-    sim.add_force(std::make_unique<swirl::testing::Spring<Real>>(Real(10), Real(0.5)));
+    sim.add_solver(swirl::testing::gravity_conditions<Real>(0.01, 0.5));
+    sim.add_solver(std::make_unique<swirl::testing::Spring<Real>>(Real(10), Real(0.5)));
     sim.start();
     const auto [message, cause] = error_of(sim, 1);
     EXPECT_EQ(cause, BlowUpCause::TimeStep);
@@ -159,8 +160,8 @@ TYPED_TEST(GuardTest, AParticleShotOutOfTheBoxIsReportedAsLeavingIt) {
   p.velocity.x[9] = Real(100);  // 1 m per step of 0.01: far through the wall
   auto settings = boxed(0.01);
   settings.escape_length = 0.05;
-  settings.limits.sph = swirl::sim::SphStepLimits{0.05, 10.0, 0.0};
   Simulation<Real> sim(std::move(p), settings);
+  sim.add_solver(swirl::testing::sph_conditions<Real>(0.05, 10.0, 0.0));
   sim.start();
   const auto [message, cause] = error_of(sim, 3);
   ASSERT_FALSE(message.empty());
@@ -179,7 +180,7 @@ TYPED_TEST(GuardTest, OrdinaryWallContactsAreNotEscapes) {
   auto settings = boxed(0.005);
   settings.escape_length = 0.05;  // |v|·dt ≤ 0.026 + ½g·dt²
   Simulation<Real> sim(std::move(p), settings);
-  sim.add_force(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
+  sim.add_solver(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
   sim.start();
   EXPECT_EQ(error_of(sim, 400).first, "");
 }
@@ -189,9 +190,9 @@ TYPED_TEST(GuardTest, WarnKeepsRunningAndReportsEachFailedCheck) {
   auto p = particles<Real>(64);
   p.velocity.x[40] = Real(3);
   auto settings = boxed(0.004);
-  settings.limits.sph = swirl::sim::SphStepLimits{0.02, 10.0, 0.0};
   settings.on_blow_up = OnBlowUp::Warn;
   Simulation<Real> sim(std::move(p), settings);
+  sim.add_solver(swirl::testing::sph_conditions<Real>(0.02, 10.0, 0.0));
   sim.start();
   for (int s = 0; s < 5; ++s) {
     sim.step();
@@ -207,9 +208,9 @@ TYPED_TEST(GuardTest, OffSkipsTheChecksButNotTheNonFinitePositions) {
   auto p = particles<Real>(64);
   p.velocity.x[40] = Real(3);
   auto settings = boxed(0.004);
-  settings.limits.sph = swirl::sim::SphStepLimits{0.02, 10.0, 0.0};
   settings.on_blow_up = OnBlowUp::Off;
   Simulation<Real> sim(std::move(p), settings);
+  sim.add_solver(swirl::testing::sph_conditions<Real>(0.02, 10.0, 0.0));
   sim.start();
   EXPECT_EQ(error_of(sim, 5).first, "");
   sim.particles().velocity.y[3] = std::numeric_limits<Real>::infinity();
@@ -227,10 +228,10 @@ TYPED_TEST(GuardTest, TheLimitsMatchAPlainEvaluationOfTheConditions) {
   }
   auto settings = boxed(1e-4);
   settings.block_size = 13;
-  const swirl::sim::SphStepLimits sph{0.03, 15.0, 0.8, 0.45, 0.3, 0.1};
-  settings.limits.sph = sph;
+  const std::array<double, 6> sph{0.03, 15.0, 0.8, 0.45, 0.3, 0.1};
   Simulation<Real> sim(std::move(p), settings);
-  sim.add_force(std::make_unique<swirl::testing::Spring<Real>>(Real(7), Real(0.4)));
+  sim.add_solver(swirl::testing::sph_conditions<Real>(sph[0], sph[1], sph[2], sph[3], sph[4], sph[5]));
+  sim.add_solver(std::make_unique<swirl::testing::Spring<Real>>(Real(7), Real(0.4)));
   sim.start();
   for (int s = 0; s < 3; ++s) sim.step();
   const auto& q = sim.particles();
@@ -248,12 +249,13 @@ TYPED_TEST(GuardTest, TheLimitsMatchAPlainEvaluationOfTheConditions) {
   }
   // The scan squares in Real: a few ulps of Real apart.
   const double tol = 8 * double(std::numeric_limits<Real>::epsilon());
-  const auto& l = sim.limits();
-  EXPECT_NEAR(l.cfl.dt, sph.cfl * sph.smoothing_length / (sph.sound_speed + std::sqrt(v2)), tol * l.cfl.dt);
-  EXPECT_EQ(l.cfl.particle, fastest);
-  EXPECT_NEAR(l.force.dt, sph.force_factor * std::sqrt(sph.smoothing_length / std::sqrt(a2)), tol * l.force.dt);
-  EXPECT_NEAR(l.viscous.dt, sph.viscous_factor * sph.smoothing_length * sph.smoothing_length * rho / sph.viscosity,
-              tol * l.viscous.dt);
+  const auto [h, c, mu, cfl, force_factor, viscous_factor] = sph;
+  const auto l_cfl = swirl::testing::limit_named(sim, "cfl"), l_force = swirl::testing::limit_named(sim, "force"),
+             l_viscous = swirl::testing::limit_named(sim, "viscous");
+  EXPECT_NEAR(l_cfl.dt, cfl * h / (c + std::sqrt(v2)), tol * l_cfl.dt);
+  EXPECT_EQ(l_cfl.particle, fastest);
+  EXPECT_NEAR(l_force.dt, force_factor * std::sqrt(h / std::sqrt(a2)), tol * l_force.dt);
+  EXPECT_NEAR(l_viscous.dt, viscous_factor * h * h * rho / mu, tol * l_viscous.dt);
 }
 
 }  // namespace

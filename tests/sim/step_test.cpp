@@ -41,7 +41,7 @@ TYPED_TEST(StepTest, BallisticParticlesFollowTheExactParabola) {
   settings.dt = 1.0 / 64;  // a power of two keeps t = n·dt exact
   settings.block_size = 8;
   Simulation<Real> sim(std::move(p), settings);
-  sim.add_force(std::make_unique<swirl::UniformGravity<Real>>(g.cast<Real>()));
+  sim.add_solver(std::make_unique<swirl::UniformGravity<Real>>(g.cast<Real>()));
   sim.start();
   constexpr int steps = 200;
   for (int s = 0; s < steps; ++s) sim.step();
@@ -67,7 +67,7 @@ TYPED_TEST(StepTest, FirstStepDoesNotKickTheInitialVelocityTwice) {
   SimulationSettings settings;
   settings.dt = 0.5;
   Simulation<Real> sim(std::move(p), settings);
-  sim.add_force(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-2)}));
+  sim.add_solver(std::make_unique<swirl::UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-2)}));
   sim.start();
   EXPECT_EQ(sim.particles().acceleration_prev.z[0], Real(-2));  // a_prev = a₀
   sim.step();
@@ -85,7 +85,7 @@ TYPED_TEST(StepTest, VelocityVerletIsSecondOrderOnAHarmonicOscillator) {
     SimulationSettings settings;
     settings.dt = 2 * M_PI / steps_per_period;
     Simulation<Real> sim(std::move(p), settings);
-    sim.add_force(std::make_unique<swirl::testing::Spring<Real>>(Real(1), Real(0)));
+    sim.add_solver(std::make_unique<swirl::testing::Spring<Real>>(Real(1), Real(0)));
     sim.start();
     for (int s = 0; s < steps_per_period; ++s) sim.step();
     return std::abs(double(sim.particles().position.x[0]) - 1.0) + std::abs(double(sim.particles().velocity.x[0]));
@@ -144,7 +144,7 @@ TYPED_TEST(StepTest, NoParticleEndsAStepFurtherOutsideThanItsStep) {
   const Vec3<double> g{0, 0, -9.81};
   settings.box = swirl::boundary::BoxCollision<double>{{{0, 0, 0}, {1, 1, 1}}, 0.3};
   Simulation<Real> sim(std::move(p), settings);
-  sim.add_force(std::make_unique<swirl::UniformGravity<Real>>(g.template cast<Real>()));
+  sim.add_solver(std::make_unique<swirl::UniformGravity<Real>>(g.template cast<Real>()));
   sim.start();
   std::size_t ever_outside = 0;
   for (int s = 0; s < 300; ++s) {

@@ -36,8 +36,8 @@ ParticleSet<Real> run_with(int threads) {
   settings.block_size = 64;  // 47 blocks: at least 8 per thread for 1, 2 and 3 threads
   settings.box = swirl::boundary::BoxCollision<double>{{{0, 0, 0}, {1, 1, 1}}, 0.7};
   swirl::Simulation<Real> sim(std::move(p), settings);
-  sim.add_force(std::make_unique<swirl::UniformGravity<Real>>(swirl::Vec3<Real>{Real(0.5), 0, Real(-9.81)}));
-  sim.add_force(std::make_unique<swirl::testing::Spring<Real>>(Real(3), Real(0.5)));
+  sim.add_solver(std::make_unique<swirl::UniformGravity<Real>>(swirl::Vec3<Real>{Real(0.5), 0, Real(-9.81)}));
+  sim.add_solver(std::make_unique<swirl::testing::Spring<Real>>(Real(3), Real(0.5)));
   sim.start();
   for (int s = 0; s < 100; ++s) sim.step();
   return sim.particles();

@@ -1,5 +1,5 @@
-// The sorted cell grid against its slow twin (brute_force_pairs), and the
-// parallel reorder that goes with it.
+// The sorted cell grid, a view of the shared particle order, against its slow
+// twin (brute_force_pairs); the order itself (keys, sort, reorder, skin).
 #include "swirl/spatial/cell_grid.hpp"
 
 #include <gtest/gtest.h>
@@ -16,7 +16,7 @@
 #include "swirl/spatial/brute_force.hpp"
 #include "swirl/spatial/distance.hpp"
 #include "swirl/spatial/reorder_particles.hpp"
-#include "swirl/spatial/skin_tracker.hpp"
+#include "swirl/spatial/particle_order.hpp"
 
 namespace {
 
@@ -64,20 +64,33 @@ Pairs pairs_of(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real
   return pairs;
 }
 
-// Sorts and reorders a copy of p with the grid, then lists every pair the
-// grid's ranges give: comparable to brute force on p when p's ids are its indices.
+// Brings p into the order a grid of support h and skin asks for (sorting and
+// reordering p in place when the order needs it) and indexes the grid on it.
+template <class Real>
+bool order_and_view(spatial::ParticleOrder<Real>& order, spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
+                    double h, std::size_t block_size, spatial::CellOrder curve, double skin = 0) {
+  order.set_request({true, spatial::SortedCellGrid<Real>::cell_length_for(h, skin), skin / 2, curve});
+  order.update(p, block_size);
+  return grid.view(order, block_size);
+}
+
+// Sorts a copy of p into the grid's order, then lists every pair the grid's
+// ranges give: comparable to brute force on p when p's ids are its indices.
 template <class Real>
 Pairs grid_pairs(const ParticleSet<Real>& p, Real h, std::size_t block_size, bool* dense = nullptr,
-                 spatial::CellOrder order = spatial::CellOrder::Rows) {
+                 spatial::CellOrder curve = spatial::CellOrder::Rows) {
+  spatial::ParticleOrder<Real> order;
   spatial::SortedCellGrid<Real> grid;
-  grid.configure(order, 0);
-  EXPECT_TRUE(grid.sort(p, double(h), block_size));
   ParticleSet<Real> q = p;
-  spatial::ParticleReorder<Real> reorder;
-  reorder.apply(q, grid.order(), block_size);
-  grid.index(block_size);
+  EXPECT_TRUE(order_and_view(order, grid, q, double(h), block_size, curve));
   if (dense) *dense = grid.dense();
   return pairs_of(grid, q, h);
+}
+
+// The ids of p in memory order.
+template <class Real>
+std::vector<std::uint64_t> ids_of(const ParticleSet<Real>& p) {
+  return {p.id.begin(), p.id.end()};
 }
 
 constexpr spatial::CellOrder kOrders[] = {spatial::CellOrder::Rows, spatial::CellOrder::Morton};
@@ -154,42 +167,39 @@ TYPED_TEST(CellGridTest, HashedTableGivesTheDenseTablesRanges) {
   using Real = TypeParam;
   const int before = parallel::thread_count();
   for (double far : {0.0, 6.0})  // 6: one particle 120 cells away along x
-    for (auto order : kOrders) {
+    for (auto curve : kOrders) {
       auto p = random_particles<Real>(3000, 1.0, 51);
       if (far > 0) p.position.x[11] = Real(far);
       const double h = 0.05;
+      spatial::ParticleOrder<Real> order;
       spatial::SortedCellGrid<Real> dense;
-      dense.configure(order, 0);
       dense.set_table(spatial::CellTable::Dense);
-      ASSERT_TRUE(dense.sort(p, h, 128));
       auto q = p;
-      spatial::ParticleReorder<Real> reorder;
-      reorder.apply(q, dense.order(), 128);
-      dense.index(128);
+      ASSERT_TRUE(order_and_view(order, dense, q, h, 128, curve));
       ASSERT_TRUE(dense.dense());
       const auto dims = dense.dims();
       for (int threads : {1, 2, 3}) {
         parallel::set_thread_count(threads);
+        spatial::ParticleOrder<Real> order2;
         spatial::SortedCellGrid<Real> hashed;
-        hashed.configure(order, 0);
         hashed.set_table(spatial::CellTable::Hashed);
-        ASSERT_TRUE(hashed.sort(p, h, 128));
-        hashed.index(128);
+        auto r = p;
+        ASSERT_TRUE(order_and_view(order2, hashed, r, h, 128, curve));
         ASSERT_FALSE(hashed.dense());
-        ASSERT_TRUE(std::equal(hashed.order().begin(), hashed.order().end(), dense.order().begin()));
+        ASSERT_EQ(ids_of(r), ids_of(q));
         spatial::NeighbourRanges a{}, b{};
         std::size_t compared = 0;
         // Every cell of the box (an empty cell's neighbours may not be).
         for (std::uint64_t z = 0; z < dims[2]; ++z)
           for (std::uint64_t y = 0; y < dims[1]; ++y)
             for (std::uint64_t x = 0; x < dims[0]; x += (far > 0 ? 3 : 1)) {
-              const std::uint64_t key = order == spatial::CellOrder::Rows ? (z * dims[1] + y) * dims[0] + x
+              const std::uint64_t key = curve == spatial::CellOrder::Rows ? (z * dims[1] + y) * dims[0] + x
                                                                           : spatial::morton_key(x, y, z);
               const int na = dense.neighbour_ranges(key, a), nb = hashed.neighbour_ranges(key, b);
               ASSERT_EQ(na, nb) << "cell " << x << " " << y << " " << z;
-              for (int r = 0; r < na; ++r) {
-                ASSERT_EQ(a[static_cast<std::size_t>(r)].begin, b[static_cast<std::size_t>(r)].begin);
-                ASSERT_EQ(a[static_cast<std::size_t>(r)].end, b[static_cast<std::size_t>(r)].end);
+              for (int k = 0; k < na; ++k) {
+                ASSERT_EQ(a[static_cast<std::size_t>(k)].begin, b[static_cast<std::size_t>(k)].begin);
+                ASSERT_EQ(a[static_cast<std::size_t>(k)].end, b[static_cast<std::size_t>(k)].end);
               }
               ++compared;
             }
@@ -206,11 +216,12 @@ TYPED_TEST(CellGridTest, RefusesADenseTableBeyondItsLimit) {
   p.position.x[5] = Real(2000);
   p.position.y[6] = Real(2000);
   p.position.z[7] = Real(2000);  // 2·10^6 cells per axis
+  spatial::ParticleOrder<Real> order;
   spatial::SortedCellGrid<Real> grid;
   grid.set_table(spatial::CellTable::Dense);
-  EXPECT_THROW(grid.sort(p, 0.001, 16), std::invalid_argument);
+  EXPECT_THROW(order_and_view(order, grid, p, 0.001, 16, spatial::CellOrder::Rows), std::invalid_argument);
   grid.set_table(spatial::CellTable::Auto);
-  EXPECT_TRUE(grid.sort(p, 0.001, 16));
+  EXPECT_TRUE(order_and_view(order, grid, p, 0.001, 16, spatial::CellOrder::Rows));
   EXPECT_FALSE(grid.dense());
 }
 
@@ -218,50 +229,71 @@ TYPED_TEST(CellGridTest, RefusesParticlesSpreadOverMoreThanTheKeyRange) {
   using Real = TypeParam;
   auto p = random_particles<Real>(100, 1.0, 1);
   p.position.y[3] = Real(1e6);  // 10^6 / 0.01 = 10^8 cells > 2^21
-  spatial::SortedCellGrid<Real> grid;
-  EXPECT_FALSE(grid.sort(p, 0.01, 16));
-  EXPECT_TRUE(grid.sort(p, 1.0, 16));
+  for (auto curve : kOrders) {
+    spatial::ParticleOrder<Real> order;
+    spatial::SortedCellGrid<Real> grid;
+    EXPECT_FALSE(order_and_view(order, grid, p, 0.01, 16, curve));
+    EXPECT_FALSE(order.cells_fit());
+    EXPECT_TRUE(order_and_view(order, grid, p, 1.0, 16, curve));
+  }
 }
 
 TYPED_TEST(CellGridTest, RejectsNonFinitePositions) {
   using Real = TypeParam;
   auto p = random_particles<Real>(100, 1.0, 1);
   p.position.z[42] = std::numeric_limits<Real>::quiet_NaN();
+  spatial::ParticleOrder<Real> order;
   spatial::SortedCellGrid<Real> grid;
-  EXPECT_THROW(grid.sort(p, 0.1, 16), std::runtime_error);
+  EXPECT_THROW(order_and_view(order, grid, p, 0.1, 16, spatial::CellOrder::Rows), std::runtime_error);
+  p.position.z[42] = std::numeric_limits<Real>::infinity();
+  EXPECT_THROW(order_and_view(order, grid, p, 0.1, 16, spatial::CellOrder::Morton), std::runtime_error);
 }
 
-TYPED_TEST(CellGridTest, ReorderMovesEveryFieldAndKeepsIds) {
+// The order's reorder moves every field (built-in, extra, internal) with its
+// particle, keeps the ids, and counts an epoch when anything moved.
+TYPED_TEST(CellGridTest, TheOrderMovesEveryFieldAndKeepsIds) {
   using Real = TypeParam;
   auto p = random_particles<Real>(1000, 1.0, 17);
   const std::size_t extra = p.add_field("extra", 3);
+  const std::size_t internal = p.add_field("internal", 1, FieldUse::Internal);
   for (std::size_t i = 0; i < p.size(); ++i) {
     p.velocity.y[i] = Real(2 * i);
     p.acceleration_prev.z[i] = Real(3 * i);
     p.density[i] = Real(4 * i);
     p.pressure[i] = Real(5 * i);
     p.extra(extra, 2)[i] = Real(6 * i);
+    p.extra(internal)[i] = Real(7 * i);
     p.id[i] = 1000000 + i;
   }
-  spatial::SortedCellGrid<Real> grid;
-  ASSERT_TRUE(grid.sort(p, 0.1, 32));
-  auto q = p;
-  spatial::ParticleReorder<Real> reorder;
-  reorder.apply(q, grid.order(), 32);
-  std::vector<bool> seen(p.size(), false);
-  for (std::size_t k = 0; k < q.size(); ++k) {
-    const std::size_t i = q.id[k] - 1000000;
-    ASSERT_LT(i, p.size());
-    EXPECT_FALSE(seen[i]);
-    seen[i] = true;
-    EXPECT_EQ(grid.order()[k], i);
-    EXPECT_EQ(q.position.x[k], p.position.x[i]);
-    EXPECT_EQ(q.velocity.y[k], p.velocity.y[i]);
-    EXPECT_EQ(q.acceleration_prev.z[k], p.acceleration_prev.z[i]);
-    EXPECT_EQ(q.mass[k], p.mass[i]);
-    EXPECT_EQ(q.density[k], p.density[i]);
-    EXPECT_EQ(q.pressure[k], p.pressure[i]);
-    EXPECT_EQ(q.extra(extra, 2)[k], p.extra(extra, 2)[i]);
+  for (auto curve : kOrders) {
+    spatial::ParticleOrder<Real> order;
+    spatial::SortedCellGrid<Real> grid;
+    auto q = p;
+    const auto epoch = order.epoch();
+    ASSERT_TRUE(order_and_view(order, grid, q, 0.1, 32, curve));
+    EXPECT_NE(order.epoch(), epoch);
+    std::vector<bool> seen(p.size(), false);
+    for (std::size_t k = 0; k < q.size(); ++k) {
+      const std::size_t i = q.id[k] - 1000000;
+      ASSERT_LT(i, p.size());
+      EXPECT_FALSE(seen[i]);
+      seen[i] = true;
+      EXPECT_EQ(q.position.x[k], p.position.x[i]);
+      EXPECT_EQ(q.velocity.y[k], p.velocity.y[i]);
+      EXPECT_EQ(q.acceleration_prev.z[k], p.acceleration_prev.z[i]);
+      EXPECT_EQ(q.mass[k], p.mass[i]);
+      EXPECT_EQ(q.density[k], p.density[i]);
+      EXPECT_EQ(q.pressure[k], p.pressure[i]);
+      EXPECT_EQ(q.extra(extra, 2)[k], p.extra(extra, 2)[i]);
+      EXPECT_EQ(q.extra(internal)[k], p.extra(internal)[i]);
+      if (k > 0) {
+        EXPECT_LE(order.keys()[k - 1], order.keys()[k]);
+      }
+    }
+    // Sorted particles sort to themselves: no move, no new epoch.
+    const auto settled = order.epoch();
+    order.update(q, 32);
+    EXPECT_EQ(order.epoch(), settled);
   }
 }
 
@@ -270,17 +302,17 @@ TYPED_TEST(CellGridTest, OrderIsTheSameForOneTwoAndThreeThreads) {
   const auto p = random_particles<Real>(40000, 1.0, 23);
   const int before = parallel::thread_count();
   for (auto cell_order : kOrders) {
-    std::vector<std::uint32_t> first;
+    std::vector<std::uint64_t> first;
     for (int threads : {1, 2, 3}) {
       parallel::set_thread_count(threads);
+      spatial::ParticleOrder<Real> order;
       spatial::SortedCellGrid<Real> grid;
-      grid.configure(cell_order, 0.004);
-      ASSERT_TRUE(grid.sort(p, 0.03, 256));
-      std::vector<std::uint32_t> order(grid.order().begin(), grid.order().end());
+      auto q = p;
+      ASSERT_TRUE(order_and_view(order, grid, q, 0.03, 256, cell_order, 0.004));
       if (first.empty())
-        first = order;
+        first = ids_of(q);
       else
-        EXPECT_EQ(order, first) << threads << " threads, " << order_name(cell_order);
+        EXPECT_EQ(ids_of(q), first) << threads << " threads, " << order_name(cell_order);
     }
   }
   parallel::set_thread_count(before);
@@ -318,13 +350,14 @@ TYPED_TEST(CellGridTest, MortonFindsTheBruteForcePairsInAThinBox) {
   for (auto order : kOrders) EXPECT_EQ(grid_pairs(p, h, 128, nullptr, order), expected) << order_name(order);
 }
 
-// The Verlet skin: particles drift a random walk for many steps; the grid is
-// sorted only when the tracker asks, and scanning its (stale) ranges must
-// still find exactly the brute-force pairs of the current positions every step.
+// The Verlet skin: particles drift a random walk for many steps; the order is
+// sorted only when a particle moved more than skin/2, and scanning the grid's
+// (stale) ranges must still find exactly the brute-force pairs of the current
+// positions every step.
 TYPED_TEST(CellGridTest, SkinFindsTheBruteForcePairsEveryStepWhileParticlesMove) {
   using Real = TypeParam;
   const Real h = Real(0.08);
-  for (auto order : kOrders)
+  for (auto curve : kOrders)
     for (double skin : {0.25 * h}) {
       auto q = random_particles<Real>(700, 1.0, 41);
       // Velocities: most slow, a few fast (up to ~0.1 skin per step), so that
@@ -334,20 +367,11 @@ TYPED_TEST(CellGridTest, SkinFindsTheBruteForcePairsEveryStepWhileParticlesMove)
         const double speed = (i % 61 == 0 ? 0.06 : 0.01) * skin;
         for (int a = 0; a < 3; ++a) q.velocity[a][i] = Real(speed * (2 * rng.uniform() - 1));
       }
+      spatial::ParticleOrder<Real> order;
       spatial::SortedCellGrid<Real> grid;
-      spatial::ParticleReorder<Real> reorder;
-      spatial::SkinTracker<Real> tracker;
-      int sorts = 0;
       const int steps = 40;
       for (int step = 0; step < steps; ++step) {
-        if (tracker.must_resort(q, skin, 64)) {
-          grid.configure(order, skin);
-          ASSERT_TRUE(grid.sort(q, double(h), 64));
-          reorder.apply(q, grid.order(), 64);
-          grid.index(64);
-          tracker.remember(q, 64);
-          ++sorts;
-        }
+        ASSERT_TRUE(order_and_view(order, grid, q, double(h), 64, curve, skin));
         // Brute force on a copy indexed by id.
         ParticleSet<Real> by_id(q.size());
         for (std::size_t i = 0; i < q.size(); ++i) {
@@ -355,7 +379,7 @@ TYPED_TEST(CellGridTest, SkinFindsTheBruteForcePairsEveryStepWhileParticlesMove)
           by_id.id[q.id[i]] = q.id[i];
         }
         ASSERT_EQ(pairs_of(grid, q, h), spatial::brute_force_pairs(by_id, h))
-            << "step " << step << ", skin " << skin << ", " << order_name(order);
+            << "step " << step << ", skin " << skin << ", " << order_name(curve);
         for (std::size_t i = 0; i < q.size(); ++i)  // drift; bounce off the unit box's walls
           for (int a = 0; a < 3; ++a) {
             Real& x = q.position[a][i];
@@ -366,41 +390,33 @@ TYPED_TEST(CellGridTest, SkinFindsTheBruteForcePairsEveryStepWhileParticlesMove)
             }
           }
       }
-      EXPECT_GT(sorts, 2) << skin;      // the fast particles force sorts
-      EXPECT_LT(sorts, steps / 2) << skin;  // ... but most steps reuse the grid
+      EXPECT_GT(order.sorts(), 2u) << skin;               // the fast particles force sorts
+      EXPECT_LT(order.sorts(), std::uint64_t(steps / 2)) << skin;  // ... but most steps reuse the order
     }
 }
 
 // The worst case of the skin: two particles two cells apart at the sort
 // (just over one cell length h + skin between them) run head-on at each other.
-// They become neighbours only after each moved about skin/2, so the tracker
-// must ask for a sort just in time; a tracker that waited longer would miss the pair.
+// They become neighbours only after each moved about skin/2, so the order
+// must sort just in time; an order that waited longer would miss the pair.
 TYPED_TEST(CellGridTest, SkinCatchesTwoParticlesRunningHeadOn) {
   using Real = TypeParam;
   const double h = 0.1, skin = 0.02;
-  for (auto order : kOrders) {
+  for (auto curve : kOrders) {
+    spatial::ParticleOrder<Real> order;
     spatial::SortedCellGrid<Real> grid;
-    grid.configure(order, skin);
     ParticleSet<Real> q(3);
     for (std::size_t i = 0; i < 3; ++i) q.id[i] = i;
-    ASSERT_TRUE(grid.sort(q, h, 8));
-    const double c = grid.cell_length(), delta = 1e-4;
+    const double c = spatial::SortedCellGrid<Real>::cell_length_for(h, skin), delta = 1e-4;
     ASSERT_GT(c, h + skin);
     // An anchor at the origin fixes the cell boundaries at multiples of c.
     q.position.set(0, Vec3d{0, 0.5, 0.5}.cast<Real>());
     q.position.set(1, Vec3d{c - delta, 0.5, 0.5}.cast<Real>());
     q.position.set(2, Vec3d{2 * c + delta, 0.5, 0.5}.cast<Real>());
-    spatial::ParticleReorder<Real> reorder;
-    spatial::SkinTracker<Real> tracker;
-    int sorts = 0, steps_as_neighbours = 0;
+    int steps_as_neighbours = 0;
     for (int step = 0; step < 40; ++step) {
-      if (tracker.must_resort(q, skin, 8)) {
-        ASSERT_TRUE(grid.sort(q, h, 8));
-        reorder.apply(q, grid.order(), 8);
-        grid.index(8);
-        tracker.remember(q, 8);
-        ++sorts;
-      }
+      ASSERT_TRUE(order_and_view(order, grid, q, h, 8, curve, skin));
+      EXPECT_EQ(grid.cell_length(), c);
       ParticleSet<Real> by_id(q.size());
       for (std::size_t i = 0; i < q.size(); ++i) {
         by_id.position.set(q.id[i], q.position.get(i));
@@ -408,40 +424,65 @@ TYPED_TEST(CellGridTest, SkinCatchesTwoParticlesRunningHeadOn) {
       }
       const Pairs expected = spatial::brute_force_pairs(by_id, Real(h));
       steps_as_neighbours += expected.size() > 0;
-      ASSERT_EQ(pairs_of(grid, q, Real(h)), expected) << "step " << step << ", " << order_name(order);
+      ASSERT_EQ(pairs_of(grid, q, Real(h)), expected) << "step " << step << ", " << order_name(curve);
       for (std::size_t i = 0; i < q.size(); ++i) {  // ids 1 and 2 approach by 0.1 skin each per step
         if (q.id[i] == 1) q.position.x[i] += Real(0.1 * skin);
         if (q.id[i] == 2) q.position.x[i] -= Real(0.1 * skin);
       }
     }
     EXPECT_GT(steps_as_neighbours, 0);
-    EXPECT_GE(sorts, 2);
+    EXPECT_GE(order.sorts(), 2u);
   }
 }
 
-TYPED_TEST(CellGridTest, SkinTrackerAsksForASortWhenTheParticlesChange) {
+TYPED_TEST(CellGridTest, TheOrderSortsAgainWhenTheParticlesChange) {
   using Real = TypeParam;
   auto p = random_particles<Real>(500, 1.0, 7);
-  spatial::SkinTracker<Real> tracker;
-  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));  // nothing remembered
-  tracker.remember(p, 32);
-  EXPECT_FALSE(tracker.must_resort(p, 0.1, 32));
-  p.position.y[123] += Real(0.049);
-  EXPECT_FALSE(tracker.must_resort(p, 0.1, 32));
-  p.position.y[123] += Real(0.002);  // 0.051 > skin/2
-  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
-  p.position.y[123] -= Real(0.051);
-  std::swap(p.id[3], p.id[4]);  // someone else reordered
-  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
-  std::swap(p.id[3], p.id[4]);
-  EXPECT_FALSE(tracker.must_resort(p, 0.1, 32));
-  p.position.x[9] = std::numeric_limits<Real>::quiet_NaN();
-  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
+  spatial::ParticleOrder<Real> order;
+  order.set_request({true, 0.2, 0.05, spatial::CellOrder::Rows});  // a skin of 0.1
+  EXPECT_TRUE(order.update(p, 32));  // the first sort
+  EXPECT_FALSE(order.update(p, 32));
+  const auto at = [&](std::uint64_t id) {
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (p.id[i] == id) return i;
+    return p.size();
+  };
+  p.position.y[at(123)] += Real(0.049);
+  EXPECT_FALSE(order.update(p, 32));
+  p.position.y[at(123)] += Real(0.002);  // 0.051 > skin/2
+  EXPECT_TRUE(order.update(p, 32));
+  const auto epoch = order.epoch();
+  order.touch();  // someone else changed the particles
+  EXPECT_NE(order.epoch(), epoch);
+  EXPECT_TRUE(order.update(p, 32));
   p.resize(499);
-  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
-  tracker.remember(p, 32);
-  tracker.forget();
-  EXPECT_TRUE(tracker.must_resort(p, 0.1, 32));
+  EXPECT_TRUE(order.update(p, 32));
+  p.position.x[9] = std::numeric_limits<Real>::quiet_NaN();
+  EXPECT_THROW(order.update(p, 32), std::runtime_error);
+}
+
+// A checkpointed order (its reference positions travel as a particle field)
+// decides as the uninterrupted one: resume() rebuilds the keys without a sort.
+TYPED_TEST(CellGridTest, AResumedOrderKeepsTheSkinsDecisions) {
+  using Real = TypeParam;
+  auto p = random_particles<Real>(800, 1.0, 12);
+  spatial::ParticleOrder<Real> order;
+  const spatial::OrderRequest request{true, 0.12, 0.01, spatial::CellOrder::Morton};
+  order.set_request(request);
+  order.update(p, 64);
+  for (std::size_t i = 0; i < p.size(); ++i) p.position.x[i] += Real(0.004 * double(i % 3));  // within skin/2
+  auto copy = p;  // what a checkpoint holds, the reference positions included
+  spatial::ParticleOrder<Real> resumed;
+  resumed.set_request(request);
+  resumed.resume(copy, 64);
+  ASSERT_TRUE(resumed.valid());
+  EXPECT_FALSE(order.update(p, 64));
+  EXPECT_FALSE(resumed.update(copy, 64));
+  EXPECT_TRUE(std::equal(order.keys().begin(), order.keys().end(), resumed.keys().begin(), resumed.keys().end()));
+  for (std::size_t i = 0; i < p.size(); ++i) p.position.x[i] += Real(0.008), copy.position.x[i] += Real(0.008);
+  EXPECT_TRUE(order.update(p, 64));
+  EXPECT_TRUE(resumed.update(copy, 64));
+  EXPECT_EQ(ids_of(p), ids_of(copy));
 }
 
 }  // namespace

@@ -75,8 +75,8 @@ double settled_gradient_ratio(sph::PressureForm form, auto real_tag) {
   params.sound_speed = c;
   params.viscosity = 5.0;  // damps the settling
   params.pressure_form = form;
-  sim.add_force(std::make_unique<sph::SphFluid<Real>>(params));
-  sim.add_force(std::make_unique<UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-g)}));
+  sim.add_solver(std::make_unique<sph::SphFluid<Real>>(params));
+  sim.add_solver(std::make_unique<UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-g)}));
   sim.start();
   double sum = 0;
   int samples = 0;
@@ -120,7 +120,7 @@ DropResult run_drop(sph::NegativePressure rule) {
   params.sound_speed = 10;
   params.viscosity = 0.5;
   params.negative_pressure = rule;
-  sim.add_force(std::make_unique<sph::SphFluid<Real>>(params));
+  sim.add_solver(std::make_unique<sph::SphFluid<Real>>(params));
   sim.start();
   auto radius = [&] {
     double r = 0;

@@ -49,6 +49,7 @@ struct Box {
   ParticleSet<Real> p;
   sph::SphParameters params;
   sph::SphFluid<Real> fluid;
+  spatial::ParticleOrder<Real> order;  // the grid is a view of it
   sph::GridPassConstants<Real> k;
 
   static sph::SphParameters parameters() {
@@ -72,7 +73,7 @@ struct Box {
       p.mass[i] = Real(1000.0 / double(kParticles));
       p.id[i] = i;
     }
-    fluid.add_acceleration(p, ForceContext{0, kBlock, nullptr});  // sorts p into cell order, builds the grid
+    swirl::evaluate_alone(fluid, p, order, kBlock);  // sorts p into cell order, builds the grid
     if (!fluid.used_grid()) throw std::runtime_error("test set-up: the grid was not used");
     k.h = Real(params.smoothing_length);
     k.h2 = k.h * k.h;
@@ -226,7 +227,7 @@ TEST(GridDispatch, TheFluidUsesTheActiveCopy) {
     std::fill(p.acceleration.x.begin(), p.acceleration.x.end(), 0.0f);
     std::fill(p.acceleration.y.begin(), p.acceleration.y.end(), 0.0f);
     std::fill(p.acceleration.z.begin(), p.acceleration.z.end(), 0.0f);
-    fluid.add_acceleration(p, ForceContext{0, kBlock, nullptr});
+    swirl::evaluate_alone(fluid, p, kBlock);
     ASSERT_TRUE(fluid.used_grid());
     ASSERT_EQ(p.id, box.p.id);
     EXPECT_TRUE(bit_identical(std::vector<float>(p.density.begin(), p.density.end()), direct.density));

@@ -49,8 +49,8 @@ std::unique_ptr<Simulation<Real>> make_box(const Setup& s, double* h_out = nullp
   params.viscosity = 0.05;
   params.cell_order = s.order;
   params.grid_skin = s.skin_over_h * h;
-  sim->add_force(std::make_unique<sph::SphFluid<Real>>(params));
-  sim->add_force(std::make_unique<UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
+  sim->add_solver(std::make_unique<sph::SphFluid<Real>>(params));
+  sim->add_solver(std::make_unique<UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
   sim->start();
   if (h_out) *h_out = h;
   return sim;
@@ -58,7 +58,7 @@ std::unique_ptr<Simulation<Real>> make_box(const Setup& s, double* h_out = nullp
 
 template <class Real>
 const sph::SphFluid<Real>& fluid_of(const Simulation<Real>& sim) {
-  return dynamic_cast<const sph::SphFluid<Real>&>(*sim.forces().front());
+  return dynamic_cast<const sph::SphFluid<Real>&>(*sim.solvers().front());
 }
 
 template <class Real>
@@ -85,7 +85,7 @@ TYPED_TEST(GridSkinTest, EveryStepFindsTheBruteForcePairs) {
         ASSERT_EQ(std::llround(found), static_cast<long long>(pairs.size()))
             << "step " << k << ", skin " << skin << ", morton " << (order == spatial::CellOrder::Morton);
       }
-      const auto sorts = fluid_of(*sim).grid_sorts();
+      const auto sorts = sim->order().sorts();
       if (skin > 0) {
         EXPECT_LT(sorts, std::uint64_t(steps));  // the skin skipped sorts ...
         EXPECT_GT(sorts, std::uint64_t(2));      // ... and was used up by the motion

@@ -27,7 +27,7 @@ TYPED_TEST(SphFluidTest, InteriorLatticeDensityIsTheRestDensity) {
   params.smoothing_length = h;
   params.rest_density = rho0;
   sph::SphFluid<Real> fluid(params);
-  fluid.add_acceleration(p, ForceContext{0, 64, nullptr});
+  swirl::evaluate_alone(fluid, p, 64);
   std::size_t interior = 0, deep_count = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const auto x = p.position.get(i).template cast<double>();
@@ -75,7 +75,7 @@ TYPED_TEST(SphFluidTest, PairForcesConserveMomentum) {
   params.sound_speed = 20;
   params.viscosity = 0.5;
   sph::SphFluid<Real> fluid(params);
-  fluid.add_acceleration(p, ForceContext{0, 100, nullptr});
+  swirl::evaluate_alone(fluid, p, 100);
   EXPECT_GT(fluid.mean_neighbors(), 5.0);
   for (int a = 0; a < 3; ++a) {
     double sum = 0, magnitude = 0;
@@ -103,8 +103,8 @@ ParticleSet<Real> run_dam_break(int threads, int steps) {
   params.rest_density = rho0;
   params.sound_speed = 20;
   params.viscosity = 0.2;
-  sim.add_force(std::make_unique<sph::SphFluid<Real>>(params));
-  sim.add_force(std::make_unique<UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
+  sim.add_solver(std::make_unique<sph::SphFluid<Real>>(params));
+  sim.add_solver(std::make_unique<UniformGravity<Real>>(Vec3<Real>{0, 0, Real(-9.81)}));
   sim.start();
   for (int k = 0; k < steps; ++k) sim.step();
   return sim.particles();
@@ -224,7 +224,7 @@ TYPED_TEST(SphFluidTest, MatchesTheBruteForceEvaluationOfTheEquations) {
     params.buckets = 97;  // a small table: many hash collisions for the cell check to drop
     sph::SphFluid<Real> fluid(params);
     auto q = p;
-    fluid.add_acceleration(q, ForceContext{0, 64, nullptr});
+    swirl::evaluate_alone(fluid, q, 64);
     const auto ref = brute_force_sph(p, params);
     // Different summation order and precision: relative to each quantity's scale.
     const double tol = std::is_same_v<Real, float> ? 2e-4 : 1e-10;

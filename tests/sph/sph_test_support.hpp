@@ -59,7 +59,7 @@ inline double pressure_acceleration_ratio(sph::PressureForm form) {
   params.viscosity = 0;
   params.pressure_form = form;
   sph::SphFluid<Real> fluid(params);
-  fluid.add_acceleration(p, ForceContext{0, 128, nullptr});
+  swirl::evaluate_alone(fluid, p, 128);
   double sum = 0;
   int n = 0;
   for (std::size_t i = 0; i < p.size(); ++i) {

@@ -4,9 +4,18 @@
 // xyz quadruples, so loops vectorise over particles): every field is an
 // AlignedVector whose storage starts on a 64-byte boundary.
 //
+// Fields: the built-in ones below, and extra fields that solvers and the
+// particle order declare by name (add_field). An extra field is either written
+// to frames (FieldUse::Output, the default: ParaView shows it) or internal
+// (FieldUse::Internal: state that travels with the particles and with
+// checkpoints but is no physical output, such as the order's reference
+// positions). for_each_array() visits every array, built-in and extra: resize,
+// reorders and checkpoints go through it, so a new field needs no other code.
+//
 // Invariants:
 //  - every field, built-in or extra, has exactly size() elements per component;
-//    change the count only through resize() and the order only through reorder();
+//    change the count only through resize() and the order only through a
+//    reorder (reorder() here, or spatial::ParticleReorder in parallel);
 //  - id[i] is the particle's stable identity: it is set once at creation and
 //    travels with the particle through every reorder().
 //
@@ -46,7 +55,11 @@ struct FieldView {
   std::string_view name;
   int components = 1;
   std::array<T*, 3> data{};  // data[c] for c < components
+  bool internal = false;     // not written to frames (FieldUse::Internal)
 };
+
+// Whether an extra field is physical output or internal state (see ParticleSet).
+enum class FieldUse { Output, Internal };
 
 template <class Real>
 class ParticleSet {
@@ -59,18 +72,27 @@ class ParticleSet {
   std::size_t size() const { return mass.size(); }
   bool empty() const { return size() == 0; }
 
+  static constexpr std::size_t npos = static_cast<std::size_t>(-1);
+
   // Changes the particle count of every field; new entries are zero.
   void resize(std::size_t n) {
-    for (auto* v : {&position, &velocity, &acceleration, &acceleration_prev}) {
-      v->x.resize(n); v->y.resize(n); v->z.resize(n);
-    }
-    mass.resize(n); density.resize(n); pressure.resize(n); id.resize(n);
-    for (auto& f : extra_) for (int c = 0; c < f.components; ++c) f.data[c].resize(n);
+    for_each_array([n](AlignedVector<Real>& a) { a.resize(n); });
+    id.resize(n);
   }
 
-  // Adds a solver-specific field (zero-filled) and returns its index; if a field
-  // of that name and shape exists already, returns its index.
-  std::size_t add_field(std::string name, int components) {
+  // Calls f(AlignedVector<Real>&) for every real array, built-in and extra, in
+  // fields() order (component by component). The ids are not included.
+  template <class F>
+  void for_each_array(F&& f) {
+    for (auto* v : {&position, &velocity, &acceleration, &acceleration_prev})
+      for (int a = 0; a < 3; ++a) f((*v)[a]);
+    f(mass); f(density); f(pressure);
+    for (auto& e : extra_) for (int c = 0; c < e.components; ++c) f(e.data[static_cast<std::size_t>(c)]);
+  }
+
+  // Adds an extra field (zero-filled) and returns its index; if a field of that
+  // name and shape exists already, returns its index (and keeps its use).
+  std::size_t add_field(std::string name, int components, FieldUse use = FieldUse::Output) {
     if (components != 1 && components != 3) throw std::invalid_argument("a field has 1 or 3 components");
     for (std::size_t k = 0; k < extra_.size(); ++k) {
       if (extra_[k].name == name) {
@@ -79,10 +101,16 @@ class ParticleSet {
       }
     }
     if (is_builtin_name(name)) throw std::invalid_argument("field '" + name + "' is a built-in field");
-    ExtraField f{std::move(name), components, {}};
-    for (int c = 0; c < components; ++c) f.data[c].assign(size(), Real(0));
+    ExtraField f{std::move(name), components, use, {}};
+    for (int c = 0; c < components; ++c) f.data[static_cast<std::size_t>(c)].assign(size(), Real(0));
     extra_.push_back(std::move(f));
     return extra_.size() - 1;
+  }
+  // The index of the extra field `name`, or npos.
+  std::size_t find_field(std::string_view name) const {
+    for (std::size_t k = 0; k < extra_.size(); ++k)
+      if (extra_[k].name == name) return k;
+    return npos;
   }
   // Component c of extra field k (as returned by add_field).
   AlignedVector<Real>& extra(std::size_t k, int c = 0) { return extra_.at(k).data.at(c); }
@@ -94,15 +122,10 @@ class ParticleSet {
   void reorder(std::span<const std::size_t> perm) {
     check_permutation(perm);
     AlignedVector<Real> scratch(size());
-    auto gather = [&](AlignedVector<Real>& a) {
+    for_each_array([&](AlignedVector<Real>& a) {
       for (std::size_t i = 0; i < perm.size(); ++i) scratch[i] = a[perm[i]];
       a.swap(scratch);
-    };
-    for (auto* v : {&position, &velocity, &acceleration, &acceleration_prev}) {
-      gather(v->x); gather(v->y); gather(v->z);
-    }
-    gather(mass); gather(density); gather(pressure);
-    for (auto& f : extra_) for (int c = 0; c < f.components; ++c) gather(f.data[c]);
+    });
     AlignedVector<std::uint64_t> ids(size());
     for (std::size_t i = 0; i < perm.size(); ++i) ids[i] = id[perm[i]];
     id.swap(ids);
@@ -128,6 +151,7 @@ class ParticleSet {
   struct ExtraField {
     std::string name;
     int components = 1;
+    FieldUse use = FieldUse::Output;
     std::array<AlignedVector<Real>, 3> data;
   };
 
@@ -161,7 +185,7 @@ class ParticleSet {
     scalar("density", self.density);
     scalar("pressure", self.pressure);
     for (auto& f : self.extra_) {
-      FieldView<T> v{f.name, f.components, {}};
+      FieldView<T> v{f.name, f.components, {}, f.use == FieldUse::Internal};
       for (int c = 0; c < f.components; ++c) v.data[c] = f.data[c].data();
       out.push_back(v);
     }

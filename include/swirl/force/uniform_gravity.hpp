@@ -1,21 +1,24 @@
-// UniformGravity: a constant external acceleration g (m/s²) on every particle,
-// the f_external/ρ term of the thesis's eq. 2.7 for a uniform field.
+// UniformGravity: a constant external acceleration g on every particle, the
+// f_external/ρ term of the thesis's eq. 2.7 for a uniform field (m/s² in SI).
+// Its potential energy is U = −Σ m_i g·x_i (zero at the origin).
 #pragma once
 
+#include <array>
+#include <cstddef>
+
 #include "swirl/core/vec3.hpp"
-#include "swirl/force/force_model.hpp"
+#include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl {
 
 template <class Real>
-class UniformGravity final : public ForceModel<Real> {
+class UniformGravity final : public Solver<Real> {
  public:
   explicit UniformGravity(Vec3<Real> g) : g_(g) {}
-
   std::string_view name() const override { return "gravity"; }
 
-  void add_acceleration(ParticleSet<Real>& p, const ForceContext& ctx) override {
+  void add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) override {
     Real* ax = p.acceleration.x.data();
     Real* ay = p.acceleration.y.data();
     Real* az = p.acceleration.z.data();
@@ -29,6 +32,21 @@ class UniformGravity final : public ForceModel<Real> {
         az[i] += g.z;
       }
     });
+  }
+
+  // Summed in double per block and folded in block order: the same bits for any thread count.
+  double potential_energy(const ParticleSet<Real>& p, std::size_t block_size) const override {
+    const Vec3d g = g_.template cast<double>();
+    return parallel::reduce_blocks(
+        "uniform_gravity_energy", p.size(), block_size, 0.0,
+        [&](std::size_t b, std::size_t e) {
+          double u = 0;
+          for (std::size_t i = b; i < e; ++i)
+            u -= double(p.mass[i]) * (g.x * double(p.position.x[i]) + g.y * double(p.position.y[i]) +
+                                      g.z * double(p.position.z[i]));
+          return u;
+        },
+        [](double a, double b) { return a + b; });
   }
 
   const Vec3<Real>& g() const { return g_; }

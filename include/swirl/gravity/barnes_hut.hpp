@@ -32,6 +32,7 @@
 // Units: G = 1; the softening and λ come from GravitySettings.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -69,10 +70,12 @@ class BarnesHut {
   // Overwrites out (resized to p.size()) with the tree field of p. block_size
   // is the block of the per-particle passes (results do not depend on it).
   void compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
-  // The same, and with the linear tree also reorders p along the Morton curve
-  // (ParticleSet::reorder: every field moves, ids survive) before the walk;
-  // out is indexed like the reordered p.
-  void compute_reordering(ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  // The linear tree as a view of particles already sorted along the Morton
+  // curve (the simulation's order: sorted_keys[i] is particle i's 63-bit key
+  // in the cube of side `side` at `corner`): no sort, no copy. Linear tree only.
+  void compute_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
+                      const std::array<double, 3>& corner, double side, GravityField<Real>& out,
+                      std::size_t block_size);
 
   // True when compute() walks the linear octree (scheme global, tree linear).
   bool uses_linear_tree() const { return settings_.scheme == Scheme::global && settings_.tree == Tree::linear; }
@@ -92,10 +95,10 @@ class BarnesHut {
     std::uint32_t entries_begin, entries_end;  // into entries_
   };
 
-  void compute_impl(const ParticleSet<Real>& p, ParticleSet<Real>* reorder, GravityField<Real>& out,
-                    std::size_t block_size);
-  void compute_linear(const ParticleSet<Real>& p, ParticleSet<Real>* reorder, GravityField<Real>& out,
-                      std::size_t block_size);
+  void compute_impl(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  void compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  LinearTreeSettings linear_settings() const;
+  void evaluate_linear(std::size_t n, GravityField<Real>& out, std::size_t block_size, double build_seconds);
   void build_subdomains(const ParticleSet<Real>& p);
   void build_global_tree(const ParticleSet<Real>& p);
   void cut_units();
@@ -117,7 +120,6 @@ class BarnesHut {
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keys_;
   std::vector<std::uint32_t> identity_;
   LinearOctree<Real> linear_;
-  std::vector<std::size_t> permutation_;
 };
 
 extern template class BarnesHut<float>;

@@ -1,50 +1,89 @@
-// GravityForce<Real>: self-gravity as a ForceModel (G = 1 N-body units).
+// GravityForce<Real>: self-gravity as a solver (force/solver.hpp).
 //
-// Each call computes the field of the particles (direct sum or Barnes–Hut with
-// the configured scheme), adds a_i to particles.acceleration and writes φ_i
-// into the extra field "potential" (added on first use), so W = ½ Σ m_i φ_i
-// comes from the same walk as the force (potential_energy() in diagnostics.hpp).
-// If ctx.timers is set, the time is recorded as the sub-phases "forces.tree_build"
-// and "forces.walk" (inside the stepper's "forces" phase). Holds the state of the
-// sub-domain load balance (the previous evaluation's work per tree) and the
-// last evaluation's statistics.
+// Each evaluation computes the field of the particles (direct sum or
+// Barnes–Hut with the configured scheme), adds G·a_i to particles.acceleration
+// and writes G·φ_i into the field "potential", so W = ½ Σ m_i φ_i comes from
+// the same walk as the force. The tree codes work in G = 1; G scales the result
+// (1 in N-body units, 6.674e-11 m³ kg⁻¹ s⁻² in SI: scene key simulation.units).
+// With ctx.timers the time is recorded as "forces.tree_build" and "forces.walk".
 //
-// With the linear tree and settings.reorder (the default), each call first
-// reorders the particles along the Morton curve (ParticleSet::reorder: every
-// field moves, ids survive), so the index of a particle changes between calls.
+// The default (global scheme, linear tree, settings.reorder) asks for the
+// simulation's particle order and builds the linear octree as a view of it
+// (gravity/linear_octree.hpp: its nodes are prefixes of the order's sorted
+// Morton keys); it never moves a particle. Every other choice — the paper's
+// tree and schemes, reorder = false, an evaluation without an order — builds
+// its own structure over the particles where they are.
+//
+// Time-step condition (ε the Plummer softening):
+//   ε > 0   Δt ≤ η · sqrt(ε / |a|max)
+//   ε = 0   Δt ≤ η · sqrt(d / |a|max), d = L / N^(1/3) the mean particle
+//           separation (L the largest extent of the particles' bounding box):
+//           without softening the smallest length the forces resolve is the
+//           spacing of the particles themselves.
 //
 // Results are bit-identical for any thread count.
 #pragma once
 
+#include <string>
 #include <string_view>
+#include <vector>
 
-#include "swirl/force/force_model.hpp"
+#include "swirl/force/solver.hpp"
 #include "swirl/gravity/barnes_hut.hpp"
 #include "swirl/gravity/field.hpp"
 #include "swirl/gravity/settings.hpp"
 
 namespace swirl::gravity {
 
+// What the solver needs beyond the tree's settings.
+struct SelfGravityOptions {
+  double G = 1;       // the gravitational constant in the scene's units (> 0)
+  double eta = 0.75;  // η of the time-step condition
+};
+
 template <class Real>
-class GravityForce final : public ForceModel<Real> {
+class GravityForce final : public Solver<Real> {
  public:
   // Validates the settings: std::invalid_argument names a bad parameter.
-  explicit GravityForce(const GravitySettings& settings = {});
+  explicit GravityForce(const GravitySettings& settings = {}, const SelfGravityOptions& options = {});
 
   std::string_view name() const override { return "self_gravity"; }
-  void add_acceleration(ParticleSet<Real>& particles, const ForceContext& ctx) override;
+  void declare_fields(ParticleSet<Real>& particles) override;
+  spatial::OrderRequest order_request() const override;
+  void add_acceleration(ParticleSet<Real>& particles, const SolverContext<Real>& ctx) override;
+
+  ScanNeeds scan_needs() const override { return {false, !(settings_.softening > 0)}; }
+  void add_limits(const StepScan& scan, std::size_t n, std::vector<StepLimit>& out) const override;
+  LimitText explain(const StepLimit& limit, std::string_view particle) const override;
+  std::string advice() const override { return "for close encounters, a larger softening"; }
+
+  std::vector<std::string> diagnostic_columns() const override { return {"virial_ratio", "mean_nodes_visited"}; }
+  void add_diagnostics(const ParticleSet<Real>& particles, std::size_t block_size,
+                       std::vector<double>& row) const override;
+  double potential_energy(const ParticleSet<Real>& particles, std::size_t block_size) const override;
+  void add_metrics(NamedValues& out) const override;
+  std::size_t scratch_bytes() const override { return stats_.tree_bytes; }
+  void save_state(NamedValues& out) const override;
+  void load_state(const NamedValues& values) override;
 
   const GravitySettings& settings() const { return settings_; }
+  const SelfGravityOptions& options() const { return options_; }
   // The last evaluation: nodes visited per particle (N − 1 for the direct sum), trees, times.
   const GravityStats& stats() const { return stats_; }
-  // The last evaluation's field.
+  // The last evaluation's field, in G = 1 units.
   const GravityField<Real>& field() const { return field_; }
 
  private:
+  bool views_order() const;
+
   GravitySettings settings_;
+  SelfGravityOptions options_;
   BarnesHut<Real> tree_;
   GravityField<Real> field_;
   GravityStats stats_;
+  double nodes_sum_ = 0;  // Σ mean_nodes_visited over evaluations (the summary's mean)
+  std::uint64_t evaluations_ = 0;
+  std::size_t particles_ = 0;
 };
 
 extern template class GravityForce<float>;

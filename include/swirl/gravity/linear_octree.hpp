@@ -121,9 +121,20 @@ class LinearOctree {
   static constexpr int kLevels = 21;  // 3 × 21 = 63 key bits
   static constexpr std::uint32_t npos = std::numeric_limits<std::uint32_t>::max();
 
-  // Builds the tree of all particles of p. block_size: the parallel block of
-  // the per-particle passes (the result does not depend on it).
+  // Builds the tree of all particles of p with its own keys and sort (the
+  // particles stay where they are; order() maps sorted slots to them).
+  // block_size: the parallel block of the per-particle passes (the result
+  // does not depend on it).
   void build(const ParticleSet<Real>& p, const LinearTreeSettings& settings, std::size_t block_size);
+
+  // Builds the tree as a view of particles already sorted by 63-bit Morton
+  // keys (the simulation's order, spatial/particle_order.hpp): sorted_keys[i]
+  // is particle i's key in the cube of side `side` at `corner` (21 bits per
+  // axis). Nothing is sorted or copied: the walk reads p's arrays, which must
+  // outlive the tree's use; order() is the identity.
+  void build_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
+                    const std::array<double, 3>& corner, double side, const LinearTreeSettings& settings,
+                    std::size_t block_size);
 
   // Declares that the caller permuted its ParticleSet by order() (p.reorder):
   // ParticleSet index and sorted slot now coincide, order() becomes the identity.
@@ -141,7 +152,7 @@ class LinearOctree {
 
   const LinearNodes<Real>& nodes() const { return nodes_; }
   std::span<const std::uint32_t> order() const { return order_; }
-  std::span<const std::uint64_t> keys() const { return sorter_.keys(); }
+  std::span<const std::uint64_t> keys() const { return keys_; }
   // Particles in curve order.
   std::span<const Real> x() const { return x_; }
   std::span<const Real> y() const { return y_; }
@@ -157,6 +168,7 @@ class LinearOctree {
   const LinearTreeSettings& settings() const { return settings_; }
 
  private:
+  void check(const ParticleSet<Real>& p, const LinearTreeSettings& settings, std::size_t block_size) const;
   void make_keys(const ParticleSet<Real>& p, std::size_t block_size);
   void make_nodes();
   void make_multipoles();
@@ -179,8 +191,10 @@ class LinearOctree {
   LinearNodes<Real> nodes_;
   parallel::RadixSort<std::uint64_t> sorter_;
   AlignedVector<std::uint64_t> raw_keys_;
+  std::span<const std::uint64_t> keys_;  // sorted: sorter_'s, or the caller's (build_sorted)
   std::vector<std::uint32_t> order_;
-  AlignedVector<Real> x_, y_, z_, m_;
+  std::span<const Real> x_, y_, z_, m_;  // particles in curve order: own_*, or the caller's
+  AlignedVector<Real> own_x_, own_y_, own_z_, own_m_;  // build(): the sorted copies
   std::array<double, 3> corner_{};
   double side_ = 0;
   int depth_ = 0;

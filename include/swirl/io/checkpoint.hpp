@@ -2,7 +2,7 @@
 // file, so that a run stopped and resumed ends bit-identical to one that never
 // stopped.
 //
-// Layout (little-endian), format version 1:
+// Layout (little-endian), format version 2 (the same layout as version 1):
 //   "SWIRLCKP"                          magic, 8 bytes
 //   u32 version, u32 real_bytes (4 | 8), u64 particles, u64 scene_hash,
 //   u64 step, f64 time
@@ -11,20 +11,23 @@
 //   the fields' data in the order listed, component by component, in the
 //   particles' current memory order; then the ids (u64 each)
 //   u64 checksum: FNV-1a 64 of every byte before it
-// Fields are every real field of the ParticleSet (positions, velocities,
-// accelerations, previous accelerations, mass, density, pressure, solver
-// fields such as "potential"); "values" carry run and solver state (frames
-// written, the next output time, the initial energy, ...). No solver holds
-// state that changes results today: SPH rebuilds its hash and lists every step,
-// and the gravity sub-domain load balance (nodes explored last step) decides
-// only which thread walks which tree, never a particle's summation order, so a
-// resumed run is bit-identical without it (tested). Adaptive time steps keep
-// their controller's state (dt_previous, dt_floor) and the step history of the
-// current frame among the values, and the time reached in the header; the
-// format is unchanged, and run_scene refuses to resume an adaptive run from a
-// checkpoint without those values. Whoever adds state
-// that changes results adds it here and bumps kCheckpointVersion; older
-// versions are refused with a message saying so.
+// Fields are every real field of the ParticleSet, output and internal alike
+// (positions, velocities, accelerations, previous accelerations, mass,
+// density, pressure, solver fields such as "potential", and the particle
+// order's reference positions when a Verlet skin is used); "values" carry the
+// state beyond the fields, each under its owner's prefix: the simulation's
+// clock ("clock.*": the adaptive controller's previous step and floor), the
+// stepper's and every solver's state ("sph.*", "self_gravity.*") and every
+// observer's ("frames.*", "diagnostics.*", "checkpoints.*"), so that a resumed
+// run is bit-identical to one that never stopped (sim/simulation.hpp,
+// sim/observer.hpp). The step and the time reached are in the header.
+//
+// Version 2 (this one): the run's values under owner prefixes, written since
+// the solver/stepper/observer seams. Version 1 files (unprefixed "frames",
+// "next_frame", ...) are refused with a message saying so: resume them with the
+// swirl that wrote them. Whoever adds state that changes results adds it
+// through save_state()/load_state() of its owner; a change of layout or of the
+// meaning of a value bumps kCheckpointVersion.
 #pragma once
 
 #include <cstdint>
@@ -37,7 +40,7 @@
 
 namespace swirl::io {
 
-inline constexpr std::uint32_t kCheckpointVersion = 1;
+inline constexpr std::uint32_t kCheckpointVersion = 2;
 
 struct CheckpointHeader {
   std::uint32_t real_bytes = 8;  // 4 (float) or 8 (double)

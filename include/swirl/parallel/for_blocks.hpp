@@ -11,11 +11,15 @@
 // Blocks go to threads in one of two ways, neither of which changes a result:
 // for_blocks/reduce_blocks are the workpool (a thread takes the next free
 // block: for irregular work such as tree walks); the _pinned variants give
-// thread t the same contiguous run of blocks on every call (OpenMP's static
-// schedule), so a particle is handled by the same core in every pass and,
-// while the particle order is stable, in every step: its data stay in that
-// core's caches. The uniform per-particle passes of the SPH grid and the
-// integrator use them (measured in docs/performance/sph-grid.md).
+// thread t the same contiguous run of blocks on every call, so a particle is
+// handled by the same core in every pass and, while the particle order is
+// stable, in every step: its data stay in that core's caches. The uniform
+// per-particle passes of the SPH grid and the integrator use them (measured in
+// docs/performance/sph-grid.md). A thread that has finished its own run then
+// takes the unstarted blocks of the others' runs, so a thread that the
+// operating system deschedules (another process busy on its core) delays the
+// pass by at most the block it holds, not by its whole run: a plain static
+// schedule collapsed below one thread's speed on a loaded 2-core machine.
 //
 // An exception thrown inside a block is caught (OpenMP would terminate the
 // program), the loop finishes, and the first one is rethrown with the kernel's
@@ -23,6 +27,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <exception>
@@ -90,8 +95,34 @@ void run_blocks(Schedule schedule, std::string_view kernel, std::size_t n, std::
     }
   };
   if (schedule == Schedule::pinned) {
-#pragma omp parallel for schedule(static)
-    for (std::int64_t b = 0; b < blocks; ++b) run(b);
+    const int wanted = static_cast<int>(std::min<std::int64_t>(omp_get_max_threads(), blocks));
+    if (wanted <= 1) {
+      for (std::int64_t b = 0; b < blocks; ++b) run(b);
+      error.rethrow(kernel);
+      return;
+    }
+    // Run r is blocks [blocks·r/T, blocks·(r+1)/T); claimed[r] counts the
+    // blocks of run r handed out, by its owner first, then by any thread done
+    // with its own run. Each block runs exactly once, whoever runs it.
+    struct alignas(64) Claimed {
+      std::atomic<std::int64_t> count{0};
+    };
+    std::vector<Claimed> claimed(static_cast<std::size_t>(wanted));
+#pragma omp parallel num_threads(wanted)
+    {
+      const std::int64_t threads = omp_get_num_threads(), self = omp_get_thread_num();
+      for (std::int64_t k = 0; k < threads; ++k) {
+        const std::int64_t r = (self + k) % threads;
+        const std::int64_t first = blocks * r / threads, last = blocks * (r + 1) / threads;
+        auto& counter = claimed[static_cast<std::size_t>(r)].count;
+        // A run already taken costs one load, not a fetch_add, to skip.
+        while (first + counter.load(std::memory_order_relaxed) < last) {
+          const std::int64_t b = first + counter.fetch_add(1, std::memory_order_relaxed);
+          if (b >= last) break;
+          run(b);
+        }
+      }
+    }
   } else {
 #pragma omp parallel for schedule(dynamic, 1)
     for (std::int64_t b = 0; b < blocks; ++b) run(b);
@@ -102,12 +133,17 @@ void run_blocks(Schedule schedule, std::string_view kernel, std::size_t n, std::
 template <class T, class BlockResult, class Combine>
 T reduce(Schedule schedule, std::string_view kernel, std::size_t n, std::size_t block_size, T init,
          BlockResult&& block_result, Combine&& combine) {
-  std::vector<T> partial(block_count(n, block_size), init);
+  // One slot per block, wrapped so that T = bool does not become the packed
+  // std::vector<bool>, whose neighbouring bits two threads would race on.
+  struct Slot {
+    T value;
+  };
+  std::vector<Slot> partial(block_count(n, block_size), Slot{init});
   run_blocks(schedule, kernel, n, block_size, [&](std::size_t begin, std::size_t end, std::size_t b) {
-    partial[b] = block_result(begin, end);
+    partial[b].value = block_result(begin, end);
   });
   T total = init;
-  for (const T& p : partial) total = combine(total, p);
+  for (const Slot& p : partial) total = combine(total, p.value);
   return total;
 }
 }  // namespace detail

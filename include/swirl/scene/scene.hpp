@@ -98,6 +98,8 @@ struct Scene {
   double restitution = 0.5;                // box.restitution, e in [0, 1]
 
   Vec3d gravity{0, 0, -9.81};              // forces.gravity, m/s², uniform
+  double damping = 0;                      // forces.damping, 1/s: a drag a = −γ·v (set-up runs)
+  double gravitational_constant = 1;       // G for [nbody] (simulation.units, nbody.G)
 
   double output_interval = 0;              // output.interval, s of simulated time; 0 = first and last frame only
   std::vector<OutputFormat> formats{OutputFormat::Vtp};  // output.format: "vtp" and/or "csv"

@@ -1,13 +1,18 @@
-// Building the Simulation a scene describes: its particles, its box and its
-// force models (SPH when the scene has [sph], self-gravity with [nbody],
-// uniform gravity when non-zero). Without walls the space is open.
-// Shared by run_scene() and the tools that inspect a scene (hash-stats).
+// Building the Simulation a scene describes: its particles, its stepper (with
+// the box's walls, or open space) and its solvers, each made from its own
+// section of the scene — SPH from [sph], self-gravity from [nbody] (G from
+// simulation.units / nbody.G), a uniform field from forces.gravity, a drag
+// from forces.damping. Nothing above this file knows which solvers a run has:
+// the run loop, the CLI and the tools see Solver<Real> only (a tool that
+// wants one kind's own figures asks Simulation::find_solver<T>()).
 #pragma once
 
 #include <memory>
 
+#include "swirl/force/damping.hpp"
 #include "swirl/force/uniform_gravity.hpp"
 #include "swirl/gravity/gravity_force.hpp"
+#include "swirl/integrate/kick_drift.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/scene.hpp"
 #include "swirl/sim/simulation.hpp"
@@ -16,41 +21,27 @@
 namespace swirl::sim {
 
 template <class Real>
-struct SceneSimulation {
-  Simulation<Real> sim;
-  sph::SphFluid<Real>* fluid = nullptr;             // owned by sim; null without [sph]
-  gravity::GravityForce<Real>* self_gravity = nullptr;  // owned by sim; null without [nbody]
-};
-
-template <class Real>
-SceneSimulation<Real> build_simulation(const scene::Scene& scene) {
+Simulation<Real> build_simulation(const scene::Scene& scene) {
   SimulationSettings settings;
   settings.dt = scene.dt;
   settings.block_size = scene.block_size;
-  if (scene.walls) settings.box = boundary::BoxCollision<double>{scene.box, scene.restitution};
-  // Time-step conditions and the blow-up guard (sim/step_limits.hpp, docs/stability.md).
   settings.adaptive = scene.adaptive_dt;
   settings.dt_min = scene.dt_min;
-  if (scene.sph) {
-    settings.limits.sph = sim::SphStepLimits{scene.sph->smoothing_length, scene.sph->sound_speed, scene.sph->viscosity,
-                                             scene.cfl, scene.force_factor, scene.viscous_factor};
-    if (scene.walls) settings.escape_length = scene.sph->smoothing_length;
-  }
-  if (scene.nbody) settings.limits.gravity = sim::GravityStepLimits{scene.nbody->softening, scene.eta};
-  SceneSimulation<Real> out{Simulation<Real>(scene::make_particles<Real>(scene), settings)};
-  if (scene.sph) {
-    auto model = std::make_unique<sph::SphFluid<Real>>(*scene.sph);
-    out.fluid = model.get();
-    out.sim.add_force(std::move(model));
-  }
-  if (scene.nbody) {
-    auto model = std::make_unique<gravity::GravityForce<Real>>(*scene.nbody);
-    out.self_gravity = model.get();
-    out.sim.add_force(std::move(model));
-  }
-  if (!(scene.gravity == Vec3d{}))
-    out.sim.add_force(std::make_unique<UniformGravity<Real>>(scene.gravity.template cast<Real>()));
-  return out;
+  // A particle further outside than the kernel support has left the box (the guard).
+  if (scene.walls && scene.sph) settings.escape_length = scene.sph->smoothing_length;
+  std::optional<boundary::BoxCollision<Real>> box;
+  if (scene.walls) box = boundary::BoxCollision<Real>{scene.box.template cast<Real>(), Real(scene.restitution)};
+  auto stepper = std::make_unique<integrate::KickDriftStepper<Real>>(integrate::Method::VelocityVerlet, std::move(box));
+  Simulation<Real> sim(scene::make_particles<Real>(scene), settings, std::move(stepper));
+  if (scene.sph)
+    sim.add_solver(std::make_unique<sph::SphFluid<Real>>(
+        *scene.sph, sph::StepConditions{scene.cfl, scene.force_factor, scene.viscous_factor}));
+  if (scene.nbody)
+    sim.add_solver(std::make_unique<gravity::GravityForce<Real>>(
+        *scene.nbody, gravity::SelfGravityOptions{scene.gravitational_constant, scene.eta}));
+  if (!(scene.gravity == Vec3d{})) sim.add_solver(std::make_unique<UniformGravity<Real>>(scene.gravity.template cast<Real>()));
+  if (scene.damping > 0) sim.add_solver(std::make_unique<Damping<Real>>(scene.damping));
+  return sim;
 }
 
 }  // namespace swirl::sim

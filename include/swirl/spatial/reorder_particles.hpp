@@ -30,15 +30,7 @@ class ParticleReorder {
     const std::size_t n = p.size();
     if (order.size() != n) throw std::invalid_argument("reorder_particles: order has the wrong length");
     std::vector<AlignedVector<Real>*> fields;
-    for (auto* v : {&p.position, &p.velocity, &p.acceleration, &p.acceleration_prev})
-      for (int a = 0; a < 3; ++a) fields.push_back(&(*v)[a]);
-    fields.push_back(&p.mass);
-    fields.push_back(&p.density);
-    fields.push_back(&p.pressure);
-    // Extra fields follow the 7 built-in ones in fields(), in creation order.
-    const auto views = p.fields();
-    for (std::size_t k = 0; k < p.extra_count(); ++k)
-      for (int c = 0; c < views[7 + k].components; ++c) fields.push_back(&p.extra(k, c));
+    p.for_each_array([&](AlignedVector<Real>& a) { fields.push_back(&a); });
     for (auto& s : scratch_) s.resize(n);
     ids_.resize(n);
     // kGroup fields per parallel loop (the ids with the first group): one

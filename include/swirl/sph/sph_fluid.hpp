@@ -1,18 +1,27 @@
-// SphFluid<Real>: the thesis's SPH fluid as a force model (sections 2.1 and 4).
+// SphFluid<Real>: the thesis's SPH fluid as a solver (sections 2.1 and 4;
+// the Solver seam: force/solver.hpp).
 //
 // Two neighbour searches (SphParameters::neighbour_search), the same physics:
-//  - Grid (the default): the particles are sorted by cell and EVERY field is
-//    moved into that order (ids travel along, so storage order changes from
-//    step to step; use id to follow a particle)                  ("forces.sort")
-//    then density and pressure, then the forces, each computed on the fly over
-//    the 27 cells (9 contiguous ranges in row order, up to 27 in Morton order:
-//    sph.grid.cell_order) around each particle, with explicit
-//    SIMD (sph/grid_passes.hpp)                  ("forces.density", "forces.sph")
-//    With a Verlet skin (sph.grid.skin > 0) the cells are h + skin wide and the
-//    sort is skipped until a particle moved more than skin/2 since the last one.
-//    Particles spread over more than 2^21 cells in an axis fall back to the hash
-//    for that evaluation.
-//  - Hash: the thesis's path, unchanged:
+//  - Grid (the default): a view of the simulation's particle order
+//    (spatial/particle_order.hpp), which this solver asks for: cells of side
+//    h + skin, in row-major or Morton order (sph.grid.cell_order), every field
+//    moved into that order by the simulation, once per step for every solver
+//    ("forces.sort"); then density and pressure, then the forces, each
+//    computed on the fly over the 27 cells (9 contiguous ranges in row order,
+//    up to 27 in Morton order) around each particle, with explicit SIMD
+//    (sph/grid_passes.hpp)                       ("forces.density", "forces.sph")
+//    With a Verlet skin (sph.grid.skin > 0) the order is kept, and the sort
+//    skipped, until a particle moved more than skin/2 since the last sort.
+//    Particles spread over more than 2^21 cells in an axis fall back to the
+//    hash for that evaluation.
+//  - Hash: the thesis's path, unchanged.
+//
+// Time-step conditions (h the kernel support radius; c the sound speed; μ the
+// dynamic viscosity; SI units), with the constants of StepConditions:
+//   CFL       Δt ≤ C_cfl · h / (c + |v|max)           (Monaghan 1992)
+//   force     Δt ≤ C_force · sqrt(h / |a|max)          (Monaghan 1992)
+//   viscous   Δt ≤ C_visc · h² · ρ_min / μ             (Morris et al. 1997: h²/ν with ν = μ/ρ)
+// |a| is the total acceleration (every solver), |v| the speed.
 //
 // Each force evaluation of the hash path:
 //  1. builds the spatial hash of the positions                  ("forces.hash")
@@ -48,6 +57,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <cstddef>
@@ -55,24 +65,34 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
+
+#include <fmt/format.h>
 
 #include "swirl/core/phase_timers.hpp"
-#include "swirl/force/force_model.hpp"
+#include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sph/grid_passes.hpp"
 #include "swirl/sph/kernels.hpp"
 #include "swirl/sph/parameters.hpp"
 #include "swirl/spatial/cell_grid.hpp"
-#include "swirl/spatial/reorder_particles.hpp"
-#include "swirl/spatial/skin_tracker.hpp"
+#include "swirl/spatial/particle_order.hpp"
 #include "swirl/spatial/spatial_hash.hpp"
 
 namespace swirl::sph {
 
+// The constants of the SPH time-step conditions (header); defaults are the usual ones.
+struct StepConditions {
+  double cfl = 0.6;               // C_cfl
+  double force_factor = 0.4;      // C_force
+  double viscous_factor = 0.125;  // C_visc
+};
+
 template <class Real>
-class SphFluid final : public ForceModel<Real> {
+class SphFluid final : public Solver<Real> {
  public:
-  explicit SphFluid(const SphParameters& params) : params_(params) {
+  explicit SphFluid(const SphParameters& params, const StepConditions& conditions = {})
+      : params_(params), conditions_(conditions) {
     if (!(params.smoothing_length > 0) || !std::isfinite(params.smoothing_length))
       throw std::invalid_argument("SPH: smoothing length must be finite and > 0");
     if (!(params.rest_density > 0)) throw std::invalid_argument("SPH: rest density must be > 0");
@@ -82,9 +102,86 @@ class SphFluid final : public ForceModel<Real> {
 
   std::string_view name() const override { return "sph"; }
 
-  void add_acceleration(ParticleSet<Real>& p, const ForceContext& ctx) override {
+  spatial::OrderRequest order_request() const override {
+    if (params_.neighbour_search != NeighbourSearch::Grid) return {};
+    const double skin = params_.grid_skin;
+    return {true, spatial::SortedCellGrid<Real>::cell_length_for(params_.smoothing_length, skin), 0.5 * skin,
+            params_.cell_order};
+  }
+
+  void add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) override {
     if (params_.neighbour_search == NeighbourSearch::Grid && add_acceleration_grid(p, ctx)) return;
     add_acceleration_hash(p, ctx);
+    count_evaluation();
+  }
+
+  ScanNeeds scan_needs() const override { return {params_.viscosity > 0, false}; }
+
+  void add_limits(const StepScan& scan, std::size_t /*n*/, std::vector<StepLimit>& out) const override {
+    const double h = params_.smoothing_length, speed = std::sqrt(scan.speed2), accel = std::sqrt(scan.accel2);
+    out.push_back({"cfl", conditions_.cfl * h / (params_.sound_speed + speed), scan.speed_at, speed, "|v|"});
+    if (accel > 0) out.push_back({"force", conditions_.force_factor * std::sqrt(h / accel), scan.accel_at, accel, "|a|"});
+    if (params_.viscosity > 0 && scan.density_at != kNoParticle)
+      out.push_back({"viscous", conditions_.viscous_factor * h * h * scan.density / params_.viscosity, scan.density_at,
+                     scan.density, "ρ"});
+  }
+
+  LimitText explain(const StepLimit& l, std::string_view id) const override {
+    const double h = params_.smoothing_length;
+    if (l.condition == "cfl")
+      return {fmt::format("the CFL condition C_cfl·h/(c + |v|max) = {}·{:.3g}/({:.3g} + {:.3g}) = {:.6g} "
+                          "(|v|max = {:.3g} at particle id {})",
+                          conditions_.cfl, h, params_.sound_speed, l.value, l.dt, l.value, id),
+              "or a larger smoothing length h"};
+    if (l.condition == "force")
+      return {fmt::format("the force condition C_force·sqrt(h/|a|max) = {}·sqrt({:.3g}/{:.3g}) = {:.6g} "
+                          "(|a|max = {:.3g} at particle id {})",
+                          conditions_.force_factor, h, l.value, l.dt, l.value, id),
+              "or a larger smoothing length h; if the fluid is exploding, a larger sound speed c"};
+    return {fmt::format("the viscous condition C_visc·h²·ρ/μ = {}·{:.3g}²·{:.3g}/{:.3g} = {:.6g} "
+                        "(ρ = {:.3g} at particle id {})",
+                        conditions_.viscous_factor, h, l.value, params_.viscosity, l.dt, l.value, id),
+            "or a smaller viscosity"};
+  }
+
+  std::string advice() const override {
+    return "if the fluid is exploding, a larger smoothing length h or sound speed c";
+  }
+
+  std::vector<std::string> diagnostic_columns() const override {
+    return {"mean_density_error", "max_density_error", "mean_neighbours"};
+  }
+  // Mean and largest |ρ − ρ0|/ρ0 (block-order sums: the same bits for any
+  // thread count), and the last evaluation's mean neighbour count.
+  void add_diagnostics(const ParticleSet<Real>& p, std::size_t block_size, std::vector<double>& row) const override {
+    using Partial = std::array<double, 2>;
+    const double rho0 = params_.rest_density;
+    const Partial e = parallel::reduce_blocks(
+        "sph_diagnostics", p.size(), block_size, Partial{},
+        [&](std::size_t b, std::size_t end) {
+          Partial s{};
+          for (std::size_t i = b; i < end; ++i) {
+            const double error = std::abs(double(p.density[i]) - rho0) / rho0;
+            s[0] += error;
+            s[1] = std::max(s[1], error);
+          }
+          return s;
+        },
+        [](Partial a, const Partial& b) { return Partial{a[0] + b[0], std::max(a[1], b[1])}; });
+    row.insert(row.end(), {p.empty() ? 0.0 : e[0] / double(p.size()), e[1], mean_neighbors_});
+  }
+  // Viscosity dissipates, and the equation of state's elastic energy is not counted.
+  bool conserves_energy() const override { return false; }
+  void add_metrics(NamedValues& out) const override {
+    out.emplace_back("mean_neighbours", evaluations_ > 0 ? neighbour_sum_ / double(evaluations_) : mean_neighbors_);
+  }
+  void save_state(NamedValues& out) const override {
+    out.emplace_back("sph.neighbour_sum", neighbour_sum_);
+    out.emplace_back("sph.evaluations", double(evaluations_));
+  }
+  void load_state(const NamedValues& values) override {
+    neighbour_sum_ = find_value(values, "sph.neighbour_sum").value_or(0.0);
+    evaluations_ = static_cast<std::uint64_t>(find_value(values, "sph.evaluations").value_or(0.0));
   }
 
   // Interaction lists of the last evaluation (one row per particle; hash search
@@ -95,14 +192,13 @@ class SphFluid final : public ForceModel<Real> {
   const spatial::SpatialHash<Real>& hash() const { return hash_; }
   const spatial::SortedCellGrid<Real>& grid() const { return grid_; }
   const SphParameters& parameters() const { return params_; }
-  // True when the last evaluation used the sorted grid (and reordered the particles).
+  // True when the last evaluation used the sorted grid.
   bool used_grid() const { return used_grid_; }
-  // Grid sorts (and reorders) so far: one per evaluation without a skin.
-  std::uint64_t grid_sorts() const { return grid_sorts_; }
+  const StepConditions& conditions() const { return conditions_; }
   // Bytes the solver keeps between evaluations (search structures, lists,
-  // reorder scratch), in all: add to the particle fields for the memory per particle.
-  std::size_t scratch_bytes() const {
-    return grid_.bytes() + reorder_.bytes() + scratch_.bytes() + skin_.bytes() +
+  // scratch), in all: add to the particle fields for the memory per particle.
+  std::size_t scratch_bytes() const override {
+    return grid_.bytes() + scratch_.bytes() +
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
            lists_.neighbor.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
@@ -110,25 +206,21 @@ class SphFluid final : public ForceModel<Real> {
   }
 
  private:
-  // The sorted grid (spatial/cell_grid.hpp, sph/grid_passes.hpp): sort by
-  // cell, reorder every field, then density and forces on the fly. Returns
+  void count_evaluation() {
+    neighbour_sum_ += mean_neighbors_;
+    ++evaluations_;
+  }
+
+  // The sorted grid (spatial/cell_grid.hpp, sph/grid_passes.hpp): a view of
+  // the simulation's order, then density and forces on the fly. Returns
   // false, having done nothing, when the particles spread too far for the grid.
-  bool add_acceleration_grid(ParticleSet<Real>& p, const ForceContext& ctx) {
+  bool add_acceleration_grid(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
+    if (!ctx.order)
+      throw std::logic_error("SPH grid: needs the simulation's particle order (or evaluate_alone())");
     {
-      PhaseScope phase(ctx, "forces.sort");
-      // With a skin (sph.grid.skin > 0) the last sort's cells of side h + skin
-      // still hold every neighbour while no particle moved more than skin/2
-      // (spatial/skin_tracker.hpp): the sort and reorder are skipped.
-      const double skin = params_.grid_skin;
-      if (!(skin > 0 && used_grid_ && !skin_.must_resort(p, skin, ctx.block_size))) {
-        grid_.configure(params_.cell_order, skin);
-        grid_.set_table(params_.cell_table);
-        if (!grid_.sort(p, params_.smoothing_length, ctx.block_size)) return false;
-        reorder_.apply(p, grid_.order(), ctx.block_size);
-        grid_.index(ctx.block_size);
-        if (skin > 0) skin_.remember(p, ctx.block_size);
-        ++grid_sorts_;
-      }
+      PhaseScope phase(ctx, "forces.cells");
+      grid_.set_table(params_.cell_table);
+      if (!grid_.view(*ctx.order, ctx.block_size)) return false;
     }
     used_grid_ = true;
     lists_ = {};
@@ -148,6 +240,7 @@ class SphFluid final : public ForceModel<Real> {
                            : grid_density<Real, false>(grid_, p, k, ctx.block_size, scratch_);
     }
     mean_neighbors_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
+    count_evaluation();
     {
       PhaseScope phase(ctx, "forces.sph");
       if (params_.simd)
@@ -159,7 +252,7 @@ class SphFluid final : public ForceModel<Real> {
   }
 
   // The thesis's path: spatial hash, lists with density inside the search.
-  void add_acceleration_hash(ParticleSet<Real>& p, const ForceContext& ctx) {
+  void add_acceleration_hash(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
     used_grid_ = false;
     const std::size_t n = p.size();
     const Real h = Real(params_.smoothing_length);
@@ -194,7 +287,7 @@ class SphFluid final : public ForceModel<Real> {
 
   // Times a sub-phase when the caller keeps timers.
   struct PhaseScope {
-    PhaseScope(const ForceContext& ctx, std::string_view name) {
+    PhaseScope(const SolverContext<Real>& ctx, std::string_view name) {
       if (ctx.timers) scope.emplace(*ctx.timers, name);
     }
     std::optional<ScopedPhase> scope;
@@ -234,14 +327,14 @@ class SphFluid final : public ForceModel<Real> {
   }
 
   SphParameters params_;
+  StepConditions conditions_;
   spatial::SpatialHash<Real> hash_;
   spatial::NeighborList<Real> lists_;
   spatial::SortedCellGrid<Real> grid_;
-  spatial::ParticleReorder<Real> reorder_;
-  spatial::SkinTracker<Real> skin_;
-  std::uint64_t grid_sorts_ = 0;
   GridScratch<Real> scratch_;
   double mean_neighbors_ = 0;
+  double neighbour_sum_ = 0;     // Σ of mean_neighbors_ over evaluations (the summary's mean)
+  std::uint64_t evaluations_ = 0;
   bool used_grid_ = false;
 };
 

@@ -1,0 +1,127 @@
+// Solver<Real>: the seam through which physics enters a simulation.
+//
+// A solver is everything about one kind of physics: the SPH fluid, self-
+// gravity, a uniform field, a drag. The simulation, the run loop and the CLI
+// know solvers only through this interface, so a new kind of physics is one
+// new class in its own module and nothing above it changes.
+//
+// What a solver owns:
+//  - its fields: declare_fields() adds what it reads or writes beyond the
+//    built-in ones (density, a potential, a kind flag), before the first step;
+//  - its computation: add_acceleration() reads the state and ADDS into
+//    particles.acceleration (the stepper zeroed it). It never permutes the
+//    particles: the simulation owns the one particle order (a solver that
+//    needs particles sorted by space asks for it with order_request() and
+//    reads the order's keys from the context). It runs its loops through
+//    parallel::for_blocks with ctx.block_size and gives bit-identical results
+//    for any thread count; it throws with a message a user can act on;
+//  - its time-step conditions: scan_needs() says what the step's scan must
+//    measure; add_limits() turns the scan into StepLimits; explain() words a
+//    limit for the blow-up guard, and advice() says what to change when the
+//    state blows up;
+//  - its diagnostics: columns and values of the per-frame log, its share of
+//    the potential energy, and summary metrics;
+//  - its state across a checkpoint (save_state/load_state): whatever changes
+//    results or the reported figures and is not a particle field.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "swirl/core/named_values.hpp"
+#include "swirl/core/particle_set.hpp"
+#include "swirl/core/phase_timers.hpp"
+#include "swirl/force/step_scan.hpp"
+#include "swirl/spatial/particle_order.hpp"
+
+namespace swirl {
+
+// What a solver may know about the evaluation it is called in.
+template <class Real>
+struct SolverContext {
+  double time = 0;                                      // simulated time of the positions
+  std::size_t block_size = 1;                           // work-block size for parallel passes
+  PhaseTimers* timers = nullptr;                        // where a solver may time its sub-phases
+  const spatial::ParticleOrder<Real>* order = nullptr;  // the particle order, current for these positions
+};
+
+// A limit's words for the guard: the rule with its numbers, and the change that relaxes it.
+struct LimitText {
+  std::string rule;  // e.g. "the CFL condition C_cfl·h/(c + |v|max) = 0.6·0.02/(20 + 3.1) = 0.00052"
+  std::string fix;   // e.g. "or a larger smoothing length h"
+};
+
+template <class Real>
+class Solver {
+ public:
+  virtual ~Solver() = default;
+
+  // A short name for summaries, phases and messages, e.g. "sph".
+  virtual std::string_view name() const = 0;
+
+  // Adds the fields this solver needs (ParticleSet::add_field); called once
+  // before the first evaluation and again after a checkpoint is read.
+  virtual void declare_fields(ParticleSet<Real>& /*particles*/) {}
+
+  // The particle order this solver needs (none by default).
+  virtual spatial::OrderRequest order_request() const { return {}; }
+
+  // Adds this solver's acceleration into particles.acceleration (see the header).
+  virtual void add_acceleration(ParticleSet<Real>& particles, const SolverContext<Real>& ctx) = 0;
+
+  // Time-step conditions.
+  virtual ScanNeeds scan_needs() const { return {}; }
+  // Appends this solver's limits for a scanned state of `n` particles.
+  virtual void add_limits(const StepScan& /*scan*/, std::size_t /*n*/, std::vector<StepLimit>& /*out*/) const {}
+  // Words for one of its own limits; `particle` is the id (or "?").
+  virtual LimitText explain(const StepLimit& limit, std::string_view particle) const {
+    return {std::string(limit.condition) + " condition (particle id " + std::string(particle) + ")", ""};
+  }
+  // What to change when the state blows up, e.g. "for close encounters, a larger softening".
+  virtual std::string advice() const { return {}; }
+
+  // Diagnostics: the solver's columns of the per-frame log and their values.
+  virtual std::vector<std::string> diagnostic_columns() const { return {}; }
+  virtual void add_diagnostics(const ParticleSet<Real>& /*particles*/, std::size_t /*block_size*/,
+                               std::vector<double>& /*row*/) const {}
+  // Its potential energy in the current state (0 for forces without one).
+  virtual double potential_energy(const ParticleSet<Real>& /*particles*/, std::size_t /*block_size*/) const {
+    return 0;
+  }
+  // False when the solver dissipates or stores energy the log does not count
+  // (then a total-energy error means nothing and is not reported).
+  virtual bool conserves_energy() const { return true; }
+  // Summary figures over the run so far, e.g. {"mean_neighbours", 24.9}.
+  virtual void add_metrics(NamedValues& /*out*/) const {}
+  // Bytes the solver keeps between evaluations (search structures, scratch).
+  virtual std::size_t scratch_bytes() const { return 0; }
+
+  // State across a checkpoint: names prefixed with name() + ".".
+  virtual void save_state(NamedValues& /*out*/) const {}
+  virtual void load_state(const NamedValues& /*values*/) {}
+};
+
+// Evaluates one solver on its own (tests, benchmarks, tools): declares its
+// fields, brings the particles into the order it asks for (through `order`,
+// which keeps its state between calls, e.g. a skin) and adds its acceleration.
+// Inside a simulation the Simulation does this for all solvers at once.
+template <class Real>
+void evaluate_alone(Solver<Real>& solver, ParticleSet<Real>& particles, spatial::ParticleOrder<Real>& order,
+                    std::size_t block_size, PhaseTimers* timers = nullptr, double time = 0) {
+  solver.declare_fields(particles);
+  order.set_request(solver.order_request());
+  order.update(particles, block_size);
+  solver.add_acceleration(particles, SolverContext<Real>{time, block_size, timers, order.active() ? &order : nullptr});
+}
+
+// The same with an order made for this one call (no skin carried over).
+template <class Real>
+void evaluate_alone(Solver<Real>& solver, ParticleSet<Real>& particles, std::size_t block_size) {
+  spatial::ParticleOrder<Real> order;
+  evaluate_alone(solver, particles, order, block_size);
+}
+
+}  // namespace swirl
