@@ -37,6 +37,11 @@ class Checker {
                                               *s_.end_time / s_.dt, s_.dt));
     if (s_.adaptive_dt && !(s_.dt_min < s_.dt))
       fail("simulation.dt_min", fmt::format("must be smaller than simulation.dt_max = {}, got {}", s_.dt, s_.dt_min));
+  }
+
+  // G is a key only with [nbody] (keys() checked it there), but a Scene built
+  // in code carries one anyway; whoever uses it may rely on G > 0.
+  void units() const {
     if (!(s_.gravitational_constant > 0) || !std::isfinite(s_.gravitational_constant))
       fail("nbody.G", fmt::format("must be finite and > 0, got {}", s_.gravitational_constant));
   }
@@ -164,6 +169,7 @@ void validate(const Scene& scene) {
   const Checker check(scene);
   check.keys();
   check.time();
+  check.units();
   check.box();
   check.nbody();
   check.sources();

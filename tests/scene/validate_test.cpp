@@ -91,6 +91,9 @@ TEST(Validate, AppliesTheRulesBetweenKeys) {
   s.nbody.emplace();
   s.gravitational_constant = 0;
   EXPECT_EQ(refusal(s), "scene: nbody.G: must be > 0, got 0");
+  s = small_scene();  // without [nbody] G is no key, but still checked
+  s.gravitational_constant = -1;
+  EXPECT_EQ(refusal(s), "scene: nbody.G: must be finite and > 0, got -1");
 }
 
 TEST(Validate, RefusesAFormatNewerThanThisBuild) {
