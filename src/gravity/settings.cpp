@@ -10,47 +10,33 @@
 namespace swirl::gravity {
 
 namespace {
-constexpr std::array<std::pair<std::string_view, Method>, 2> kMethods{{
-    {"direct", Method::direct}, {"barnes_hut", Method::barnes_hut}}};
-constexpr std::array<std::pair<std::string_view, Scheme>, 3> kSchemes{{
-    {"subdomain", Scheme::subdomain}, {"subtree", Scheme::subtree}, {"global", Scheme::global}}};
-constexpr std::array<std::pair<std::string_view, Tree>, 2> kTrees{{{"paper", Tree::paper}, {"linear", Tree::linear}}};
-constexpr std::array<std::pair<std::string_view, Multipole>, 2> kMultipoles{{
-    {"monopole", Multipole::monopole}, {"quadrupole", Multipole::quadrupole}}};
-constexpr std::array<std::pair<std::string_view, Criterion>, 2> kCriteria{{
-    {"paper", Criterion::paper}, {"barnes", Criterion::barnes}}};
-constexpr std::array<std::pair<std::string_view, Walk>, 2> kWalks{{{"group", Walk::group}, {"particle", Walk::particle}}};
-
 template <class Enum, std::size_t N>
-Enum parse(std::string_view what, std::string_view name, const std::array<std::pair<std::string_view, Enum>, N>& table) {
+Enum parse(std::string_view what, std::string_view name, const std::array<EnumName<Enum>, N>& table) {
+  if (const auto value = enum_value<Enum>(table, name)) return *value;
   std::string allowed;
-  for (const auto& [n, value] : table) {
-    if (n == name) return value;
-    allowed += fmt::format("{}\"{}\"", allowed.empty() ? "" : ", ", n);
-  }
+  for (const auto& entry : table) allowed += fmt::format("{}\"{}\"", allowed.empty() ? "" : ", ", entry.name);
   throw std::invalid_argument(fmt::format("unknown gravity {} \"{}\" (allowed: {})", what, name, allowed));
 }
 
 template <class Enum, std::size_t N>
-std::string_view name_of(Enum value, const std::array<std::pair<std::string_view, Enum>, N>& table) {
-  for (const auto& [n, v] : table)
-    if (v == value) return n;
-  return "?";
+std::string_view name_of(Enum value, const std::array<EnumName<Enum>, N>& table) {
+  const std::string_view name = enum_name<Enum>(table, value);
+  return name.empty() ? "?" : name;
 }
 }  // namespace
 
-std::string_view to_string(Method method) { return name_of(method, kMethods); }
-std::string_view to_string(Scheme scheme) { return name_of(scheme, kSchemes); }
-std::string_view to_string(Tree tree) { return name_of(tree, kTrees); }
-std::string_view to_string(Multipole multipole) { return name_of(multipole, kMultipoles); }
-std::string_view to_string(Criterion criterion) { return name_of(criterion, kCriteria); }
-std::string_view to_string(Walk walk) { return name_of(walk, kWalks); }
-Walk parse_walk(std::string_view name) { return parse("walk", name, kWalks); }
-Tree parse_tree(std::string_view name) { return parse("tree", name, kTrees); }
-Multipole parse_multipole(std::string_view name) { return parse("multipole", name, kMultipoles); }
-Criterion parse_criterion(std::string_view name) { return parse("opening criterion", name, kCriteria); }
-Method parse_method(std::string_view name) { return parse("method", name, kMethods); }
-Scheme parse_scheme(std::string_view name) { return parse("scheme", name, kSchemes); }
+std::string_view to_string(Method method) { return name_of(method, kMethodNames); }
+std::string_view to_string(Scheme scheme) { return name_of(scheme, kSchemeNames); }
+std::string_view to_string(Tree tree) { return name_of(tree, kTreeNames); }
+std::string_view to_string(Multipole multipole) { return name_of(multipole, kMultipoleNames); }
+std::string_view to_string(Criterion criterion) { return name_of(criterion, kCriterionNames); }
+std::string_view to_string(Walk walk) { return name_of(walk, kWalkNames); }
+Walk parse_walk(std::string_view name) { return parse("walk", name, kWalkNames); }
+Tree parse_tree(std::string_view name) { return parse("tree", name, kTreeNames); }
+Multipole parse_multipole(std::string_view name) { return parse("multipole", name, kMultipoleNames); }
+Criterion parse_criterion(std::string_view name) { return parse("opening criterion", name, kCriterionNames); }
+Method parse_method(std::string_view name) { return parse("method", name, kMethodNames); }
+Scheme parse_scheme(std::string_view name) { return parse("scheme", name, kSchemeNames); }
 
 void validate(const GravitySettings& s) {
   // Written so that NaN fails every test.

@@ -13,8 +13,11 @@
 // with the λ rule (the scene loader refuses other choices for it).
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <string_view>
+
+#include "swirl/core/enum_names.hpp"
 
 namespace swirl::gravity {
 
@@ -49,6 +52,16 @@ enum class Criterion { paper, barnes };
 //             its particles by the SIMD kernels (interaction_kernels.hpp);
 //   particle  one walk per particle: the group walk's slow twin and reference.
 enum class Walk { group, particle };
+
+// The names scenes, messages and options use: the only place they are spelt.
+inline constexpr std::array<EnumName<Method>, 2> kMethodNames{{{"direct", Method::direct}, {"barnes_hut", Method::barnes_hut}}};
+inline constexpr std::array<EnumName<Scheme>, 3> kSchemeNames{
+    {{"subdomain", Scheme::subdomain}, {"subtree", Scheme::subtree}, {"global", Scheme::global}}};
+inline constexpr std::array<EnumName<Tree>, 2> kTreeNames{{{"paper", Tree::paper}, {"linear", Tree::linear}}};
+inline constexpr std::array<EnumName<Multipole>, 2> kMultipoleNames{
+    {{"monopole", Multipole::monopole}, {"quadrupole", Multipole::quadrupole}}};
+inline constexpr std::array<EnumName<Criterion>, 2> kCriterionNames{{{"paper", Criterion::paper}, {"barnes", Criterion::barnes}}};
+inline constexpr std::array<EnumName<Walk>, 2> kWalkNames{{{"group", Walk::group}, {"particle", Walk::particle}}};
 
 std::string_view to_string(Method method);
 std::string_view to_string(Scheme scheme);

@@ -1,14 +1,18 @@
-// Loading and validating scene files.
+// Loading scene files: TOML text to a validated Scene.
 //
-// Scene file format (TOML; every key listed in docs/scenes.md):
+// Scene file format (TOML; every key is declared in scene/keys.hpp and listed
+// in docs/scenes.md):
 //
-//   [simulation]  precision = "float" | "double", dt, end_time | steps, block_size
+//   format = N    (optional root key: the file format version, 1 today)
+//   [simulation]  precision, units = "si" | "nbody", dt, end_time | steps, block_size, time-step control
 //   [box]         min = [x, y, z], max = [x, y, z], restitution
-//   [forces]      gravity = [gx, gy, gz]
+//   [forces]      gravity = [gx, gy, gz], damping
 //   [output]      interval, format = "vtp" | "csv" | ["vtp", "csv"]
-//   [[particles]] kind = "lattice" | "random" | "list", and the kind's keys
+//   [sph], [nbody], [random_box]
+//   [[particles]] kind = "lattice" | "random" | "list" | "fluid_block" | a stellar model, and the kind's keys
 //
-// Unknown keys are errors that suggest the closest known key.
+// Unknown keys are errors that suggest the closest known key. The scene read
+// is then checked by validate() (scene/validate.hpp), as a Scene built in code is.
 #pragma once
 
 #include <filesystem>
@@ -30,7 +34,8 @@ Scene load_scene(const std::filesystem::path& file, std::span<const std::string>
 Scene parse_scene(std::string_view text, std::string_view file, std::span<const std::string> overrides = {});
 
 // A stable 64-bit hash of the validated scene (FNV-1a over its canonical TOML
-// form), so a checkpoint can tell which scene it belongs to.
+// form: every declared key but `format`, docs/scenes.md "Scene hash"), so a
+// checkpoint can tell which scene it belongs to.
 std::uint64_t scene_hash(const Scene& scene);
 
 }  // namespace swirl::scene

@@ -1,12 +1,16 @@
 // Scene: the typed, validated description of one simulation, made from a TOML
-// scene file by load_scene(). A solver never sees TOML; it sees this.
+// scene file by load_scene() or built in code and checked by validate()
+// (scene/validate.hpp). A solver never sees TOML; it sees this.
 //
-// Units are SI for SPH scenes (m, s, kg) and G = 1 N-body units for gravity
-// scenes. Every value here has passed validation: dt > 0, a valid box,
+// Units: `units` says which system the numbers are in, SI (m, s, kg) or
+// N-body units (G = 1 unless nbody.G says otherwise); gravitational_constant is
+// the resolved G. A loaded scene has passed validation: dt > 0, a valid box,
 // restitution in [0, 1], at least one particle, all particles inside the box
-// (when the scene has walls).
+// (when the scene has walls). Each key's name, unit, default and range are
+// declared once, in scene/keys.hpp; the defaults are the member initialisers here.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -16,6 +20,7 @@
 #include <vector>
 
 #include "swirl/core/box.hpp"
+#include "swirl/core/enum_names.hpp"
 #include "swirl/core/vec3.hpp"
 #include "swirl/gravity/initial_conditions.hpp"
 #include "swirl/gravity/settings.hpp"
@@ -25,6 +30,20 @@ namespace swirl::scene {
 
 enum class Precision { Float, Double };
 enum class OutputFormat { Vtp, Csv };
+// The unit system of a scene's numbers: SI (m, s, kg; G = 6.67430e-11
+// m³ kg⁻¹ s⁻²) or N-body units (G = 1, Hénon units for the stellar models).
+enum class Units { SI, NBody };
+
+inline constexpr std::array<EnumName<Precision>, 2> kPrecisionNames{{{"float", Precision::Float}, {"double", Precision::Double}}};
+inline constexpr std::array<EnumName<OutputFormat>, 2> kOutputFormatNames{{{"vtp", OutputFormat::Vtp}, {"csv", OutputFormat::Csv}}};
+inline constexpr std::array<EnumName<Units>, 2> kUnitsNames{{{"si", Units::SI}, {"nbody", Units::NBody}}};
+
+// The gravitational constant in SI units, m³ kg⁻¹ s⁻² (CODATA 2018).
+inline constexpr double kGravitationalConstantSI = 6.67430e-11;
+
+// The scene file format this build reads and writes (the root key `format`).
+// A file without the key is of this format; a newer one is refused.
+inline constexpr std::uint32_t kSceneFormatVersion = 1;
 
 // Particles on a simple cubic lattice filling `region`: one at the centre of
 // every spacing-sized cell that fits wholly inside the region, i.e.
@@ -71,12 +90,26 @@ struct StellarSource {
   Vec3d velocity{};
 };
 
+// The stellar models' names, which are also their [[particles]] kinds.
+inline constexpr std::array<EnumName<StellarSource::Model>, 5> kStellarModelNames{{
+    {"plummer", StellarSource::Model::Plummer},
+    {"uniform_sphere", StellarSource::Model::UniformSphere},
+    {"uniform_cube", StellarSource::Model::UniformCube},
+    {"cold_collapse", StellarSource::Model::ColdCollapse},
+    {"plummer_collision", StellarSource::Model::PlummerCollision},
+}};
+
 using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource>;
 
 struct Scene {
   std::string file;                        // where it came from, for messages
   std::string toml;                        // the scene as TOML after --set overrides (parse_scene fills
                                            // it): saved beside a run's outputs so it can be resumed
+  std::uint32_t format_version = kSceneFormatVersion;  // root key `format`, 1 ≤ version ≤ kSceneFormatVersion
+  Units units = Units::SI;                 // simulation.units; a loaded scene defaults to NBody when it has
+                                           // [nbody] and no [sph], else SI
+  double gravitational_constant = kGravitationalConstantSI;  // G, resolved: nbody.G if given, else 1 in
+                                           // N-body units and kGravitationalConstantSI in SI (> 0)
   Precision precision = Precision::Float;  // simulation.precision, default "float"
   double dt = 0;                           // simulation.dt, s, > 0 (adaptive: the largest step, dt_max)
   std::optional<double> end_time;          // simulation.end_time, s (exactly one of end_time, steps)
@@ -98,8 +131,7 @@ struct Scene {
   double restitution = 0.5;                // box.restitution, e in [0, 1]
 
   Vec3d gravity{0, 0, -9.81};              // forces.gravity, m/s², uniform
-  double damping = 0;                      // forces.damping, 1/s: a drag a = −γ·v (set-up runs)
-  double gravitational_constant = 1;       // G for [nbody] (simulation.units, nbody.G)
+  double damping = 0;                      // forces.damping, 1/s, ≥ 0: a drag a = −damping·v (settling runs)
 
   double output_interval = 0;              // output.interval, s of simulated time; 0 = first and last frame only
   std::vector<OutputFormat> formats{OutputFormat::Vtp};  // output.format: "vtp" and/or "csv"
@@ -121,7 +153,7 @@ struct Scene {
   };
   std::optional<RandomBox> random_box;
 
-  // [nbody]: self-gravity (Barnes–Hut or direct sum), G = 1 units.
+  // [nbody]: self-gravity (Barnes–Hut or direct sum), with G = gravitational_constant.
   std::optional<gravity::GravitySettings> nbody;
 
   // Number of steps the scene asks for: `steps`, or ceil(end_time / dt) (a step

@@ -18,8 +18,10 @@
 // (spatial/occupied_cell_table.hpp) for particles spread over a huge region.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
+#include "swirl/core/enum_names.hpp"
 #include "swirl/core/morton.hpp"
 
 namespace swirl::spatial {
@@ -34,6 +36,11 @@ enum class CellTable {
   Dense,   // always dense (an error beyond 2^31 keys)
   Hashed,  // always the hash table of occupied cells
 };
+
+// The names scenes use (sph.grid.cell_order, sph.grid.table).
+inline constexpr std::array<EnumName<CellOrder>, 2> kCellOrderNames{{{"rows", CellOrder::Rows}, {"morton", CellOrder::Morton}}};
+inline constexpr std::array<EnumName<CellTable>, 3> kCellTableNames{
+    {{"auto", CellTable::Auto}, {"dense", CellTable::Dense}, {"hashed", CellTable::Hashed}}};
 
 // The Morton key functions live in core/morton.hpp (shared with the octree).
 using swirl::morton_compact;

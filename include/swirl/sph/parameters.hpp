@@ -2,9 +2,11 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
+#include "swirl/core/enum_names.hpp"
 #include "swirl/spatial/cell_order.hpp"
 
 namespace swirl::sph {
@@ -27,6 +29,14 @@ enum class NeighbourSearch {
   Grid,  // sorted cell grid, particles reordered in memory, passes on the fly (spatial/cell_grid.hpp)
   Hash,  // the thesis's spatial hash with CSR interaction lists (spatial/spatial_hash.hpp)
 };
+
+// The names scenes use (sph.pressure, sph.negative_pressure, sph.neighbour_search).
+inline constexpr std::array<EnumName<PressureForm>, 2> kPressureFormNames{
+    {{"thesis", PressureForm::Thesis}, {"consistent", PressureForm::Consistent}}};
+inline constexpr std::array<EnumName<NegativePressure>, 2> kNegativePressureNames{
+    {{"keep", NegativePressure::Keep}, {"zero", NegativePressure::Zero}}};
+inline constexpr std::array<EnumName<NeighbourSearch>, 2> kNeighbourSearchNames{
+    {{"grid", NeighbourSearch::Grid}, {"hash", NeighbourSearch::Hash}}};
 
 struct SphParameters {
   double smoothing_length = 0;     // h, m (> 0): kernel support and hash cell length

@@ -1,0 +1,790 @@
+// The declaration of every scene key (scene/keys.hpp), and the docs' key
+// tables made from it.
+#include "swirl/scene/keys.hpp"
+
+#include <algorithm>
+#include <iterator>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "sources.hpp"
+
+namespace swirl::scene {
+
+std::string Range::text() const {
+  if (unbounded()) return {};
+  if (std::isinf(hi)) return fmt::format("{} {}", lo_open ? ">" : ">=", lo);
+  if (std::isinf(lo)) return fmt::format("{} {}", hi_open ? "<" : "<=", hi);
+  return fmt::format("in {}{}, {}{}", lo_open ? '(' : '[', lo, hi, hi_open ? ')' : ']');
+}
+
+namespace {
+
+// ---- From typed fields to KeyValue and back ---------------------------------
+
+// The name tables, found by the enum's type.
+constexpr std::span<const EnumName<Precision>> names_of(Precision) { return kPrecisionNames; }
+constexpr std::span<const EnumName<Units>> names_of(Units) { return kUnitsNames; }
+constexpr std::span<const EnumName<OutputFormat>> names_of(OutputFormat) { return kOutputFormatNames; }
+constexpr std::span<const EnumName<sph::PressureForm>> names_of(sph::PressureForm) { return sph::kPressureFormNames; }
+constexpr std::span<const EnumName<sph::NegativePressure>> names_of(sph::NegativePressure) {
+  return sph::kNegativePressureNames;
+}
+constexpr std::span<const EnumName<sph::NeighbourSearch>> names_of(sph::NeighbourSearch) {
+  return sph::kNeighbourSearchNames;
+}
+constexpr std::span<const EnumName<spatial::CellOrder>> names_of(spatial::CellOrder) { return spatial::kCellOrderNames; }
+constexpr std::span<const EnumName<spatial::CellTable>> names_of(spatial::CellTable) { return spatial::kCellTableNames; }
+constexpr std::span<const EnumName<gravity::Method>> names_of(gravity::Method) { return gravity::kMethodNames; }
+constexpr std::span<const EnumName<gravity::Scheme>> names_of(gravity::Scheme) { return gravity::kSchemeNames; }
+constexpr std::span<const EnumName<gravity::Tree>> names_of(gravity::Tree) { return gravity::kTreeNames; }
+constexpr std::span<const EnumName<gravity::Multipole>> names_of(gravity::Multipole) { return gravity::kMultipoleNames; }
+constexpr std::span<const EnumName<gravity::Criterion>> names_of(gravity::Criterion) { return gravity::kCriterionNames; }
+constexpr std::span<const EnumName<gravity::Walk>> names_of(gravity::Walk) { return gravity::kWalkNames; }
+
+template <class T>
+concept NamedEnum = std::is_enum_v<T> && requires(T v) { names_of(v); };
+template <class T>
+concept Count = std::is_integral_v<T> && std::is_unsigned_v<T> && !std::is_same_v<T, bool>;
+
+// A std::vector of a named enum: a NameList key.
+template <class T>
+concept EnumList = requires { typename T::value_type; } && NamedEnum<typename T::value_type>;
+
+template <class T>
+struct OptionalOf {};
+template <class T>
+struct OptionalOf<std::optional<T>> {
+  using type = T;
+};
+template <class T>
+concept Optional = requires { typename OptionalOf<T>::type; };
+
+template <NamedEnum E>
+std::vector<std::string_view> name_list() {
+  std::vector<std::string_view> out;
+  for (const auto& entry : names_of(E{})) out.push_back(entry.name);
+  return out;
+}
+
+// The key type a field of type T has, and its names when it holds enums.
+template <class T>
+constexpr KeyType key_type() {
+  if constexpr (Optional<T>) return key_type<typename OptionalOf<T>::type>();
+  else if constexpr (std::is_same_v<T, double>) return KeyType::Number;
+  else if constexpr (std::is_same_v<T, bool>) return KeyType::Boolean;
+  else if constexpr (Count<T>) return KeyType::Integer;
+  else if constexpr (NamedEnum<T>) return KeyType::Name;
+  else if constexpr (std::is_same_v<T, Vec3d>) return KeyType::Vector;
+  else if constexpr (std::is_same_v<T, std::vector<Vec3d>>) return KeyType::VectorList;
+  else if constexpr (std::is_same_v<T, std::vector<double>>) return KeyType::NumberList;
+  else return KeyType::NameList;  // std::vector of a named enum
+}
+
+template <class T>
+std::vector<std::string_view> names_for() {
+  if constexpr (Optional<T>) return names_for<typename OptionalOf<T>::type>();
+  else if constexpr (NamedEnum<T>) return name_list<T>();
+  else if constexpr (EnumList<T>)
+    return name_list<typename T::value_type>();
+  else return {};
+}
+
+template <class T>
+std::optional<KeyValue> to_value(const T& v) {
+  if constexpr (Optional<T>) {
+    if (!v) return std::nullopt;
+    return to_value(*v);
+  } else if constexpr (Count<T>) {
+    return KeyValue{static_cast<std::uint64_t>(v)};
+  } else if constexpr (NamedEnum<T>) {
+    // An enum cast from an out-of-range integer has no name; validate() refuses "".
+    return KeyValue{enum_name(names_of(v), v)};
+  } else if constexpr (EnumList<T>) {
+    std::vector<std::string_view> names;
+    for (const auto item : v) names.push_back(enum_name(names_of(item), item));
+    return KeyValue{std::move(names)};
+  } else {
+    return KeyValue{v};
+  }
+}
+
+template <class E>
+E enum_of(std::string_view name) {
+  // The reader and validate() only store names from the key's list.
+  return enum_value(names_of(E{}), name).value_or(E{});
+}
+
+template <class T>
+void from_value(const KeyValue& v, T& out) {
+  if constexpr (Optional<T>) {
+    typename OptionalOf<T>::type inner{};
+    from_value(v, inner);
+    out = inner;
+  } else if constexpr (Count<T>) {
+    out = static_cast<T>(std::get<std::uint64_t>(v));
+  } else if constexpr (NamedEnum<T>) {
+    out = enum_of<T>(std::get<std::string_view>(v));
+  } else if constexpr (EnumList<T>) {
+    out.clear();
+    for (const auto name : std::get<std::vector<std::string_view>>(v)) out.push_back(enum_of<typename T::value_type>(name));
+  } else {
+    out = std::get<T>(v);
+  }
+}
+
+// `spec` for the field `locate` finds: locate(owner) is a pointer to it, or
+// nullptr when the owner has no such field (its section is absent). Type and
+// names come from the field's type.
+template <class Owner, class Locate>
+KeySpec<Owner> field(KeySpec<Owner> spec, Locate locate) {
+  using T = std::remove_cvref_t<decltype(*locate(std::declval<Owner&>()))>;
+  spec.type = key_type<T>();
+  spec.names = names_for<T>();
+  spec.get = [locate](const Owner& o) -> std::optional<KeyValue> {
+    const auto* p = locate(o);
+    if (!p) return std::nullopt;
+    return to_value(*p);
+  };
+  spec.set = [locate](Owner& o, const KeyValue& v) {
+    if (auto* p = locate(o)) from_value(v, *p);
+  };
+  return spec;
+}
+
+// Locators. A section's fields exist only when the section does.
+template <class M>
+auto in_scene(M Scene::*member) {
+  return [member](auto& s) { return &(s.*member); };
+}
+template <class M>
+auto in_sph(M sph::SphParameters::*member) {
+  return [member](auto& s) { return s.sph ? &((*s.sph).*member) : nullptr; };
+}
+template <class M>
+auto in_nbody(M gravity::GravitySettings::*member) {
+  return [member](auto& s) { return s.nbody ? &((*s.nbody).*member) : nullptr; };
+}
+template <class M>
+auto in_random_box(M Scene::RandomBox::*member) {
+  return [member](auto& s) { return s.random_box ? &((*s.random_box).*member) : nullptr; };
+}
+template <class Source, class M>
+auto in_source(M Source::*member) {
+  return [member](auto& src) {
+    auto* s = std::get_if<Source>(&src);
+    return s ? &(s->*member) : nullptr;
+  };
+}
+
+constexpr Range kPositive{0, std::numeric_limits<double>::infinity(), true, false};
+constexpr Range kNonNegative{0, std::numeric_limits<double>::infinity(), false, false};
+constexpr Range kUnit{0, 1, false, false};
+constexpr Range kFraction{0, 1, true, false};
+constexpr Range kAtLeastOne{1, std::numeric_limits<double>::infinity(), false, false};
+// Counts of particles a source may make: 1 to 2^31.
+constexpr Range kParticleCount{1, static_cast<double>(detail::kMaxParticles), false, false};
+// Sizes of tree nodes and groups: 1 to 2^20.
+constexpr Range kTreeSize{1, 1 << 20, false, false};
+// A length beyond 1e9 m is a typo; it would also overflow h³.
+constexpr Range kSupport{0, 1e9, true, false};
+constexpr Range kNeighbourCount{0, 10000, true, false};
+
+using SceneKey = KeySpec<Scene>;
+using SourceKey = KeySpec<ParticleSource>;
+
+std::vector<SceneKey> declare_scene_keys() {
+  std::vector<SceneKey> k;
+  const auto add = [&](SceneKey spec) { k.push_back(std::move(spec)); };
+
+  // The root.
+  add(field(SceneKey{.key = "format", .section = "", .range = kAtLeastOne,
+                     .doc = "the scene format version: absent means the current one; a newer one is refused",
+                     .custom_read = true, .hashed = false},
+            in_scene(&Scene::format_version)));
+
+  // [simulation]
+  add(field(SceneKey{.key = "simulation.precision", .section = "simulation", .noun = "precision",
+                     .doc = "the floating-point type of the particle fields and the solver",
+                     .default_doc = "`\"float\"`, `\"double\"` with `[nbody]`",
+                     .context_default = [](const Scene& s) { return to_value(s.nbody ? Precision::Double : Precision::Float); }},
+            in_scene(&Scene::precision)));
+  add(field(SceneKey{.key = "simulation.units", .section = "simulation", .noun = "unit system",
+                     .doc = "`\"si\"`: m, s, kg, G = 6.67430e-11 m³ kg⁻¹ s⁻²; `\"nbody\"`: G = 1 (or `nbody.G`)",
+                     .default_doc = "`\"nbody\"` with `[nbody]` and no `[sph]`, else `\"si\"`",
+                     .context_default = [](const Scene& s) {
+                       return to_value(s.nbody && !s.sph ? Units::NBody : Units::SI);
+                     }},
+            in_scene(&Scene::units)));
+  SceneKey dt{.key = "simulation.dt", .section = "simulation", .type = KeyType::Number, .unit = "s",
+              .range = kPositive,
+              .doc = "the time step; `\"adaptive\"`: every step chosen from the conditions below ([stability.md](stability.md))",
+              .required = true, .type_doc = "number or `\"adaptive\"`", .custom_read = true};
+  dt.get = [](const Scene& s) -> std::optional<KeyValue> {
+    if (s.adaptive_dt) return KeyValue{std::string_view("adaptive")};
+    return KeyValue{s.dt};
+  };
+  add(std::move(dt));
+  add(field(SceneKey{.key = "simulation.end_time", .section = "simulation", .unit = "s", .range = kPositive,
+                     .doc = "the simulated time to run; exactly one of `end_time` and `steps` is required",
+                     .default_doc = "–", .custom_read = true},
+            in_scene(&Scene::end_time)));
+  add(field(SceneKey{.key = "simulation.steps", .section = "simulation", .range = kAtLeastOne,
+                     .doc = "the number of steps; exactly one of `end_time` and `steps` is required",
+                     .default_doc = "–", .custom_read = true},
+            in_scene(&Scene::steps)));
+  add(field(SceneKey{.key = "simulation.block_size", .section = "simulation", .unit = "particles", .range = kAtLeastOne,
+                     .doc = "particles per parallel work block; results are identical for any thread count at a given block size"},
+            in_scene(&Scene::block_size)));
+  SceneKey dt_max{.key = "simulation.dt_max", .section = "simulation", .type = KeyType::Number, .unit = "s",
+                  .range = kPositive,
+                  .doc = "only with `dt = \"adaptive\"`: the largest step; required when the default does not apply "
+                         "or the scene has neither `[sph]` nor `[nbody]`",
+                  .default_doc = "`output.interval` (else `end_time`)", .custom_read = true};
+  dt_max.get = [](const Scene& s) -> std::optional<KeyValue> {
+    if (!s.adaptive_dt) return std::nullopt;
+    return KeyValue{s.dt};
+  };
+  add(std::move(dt_max));
+  SceneKey dt_min{.key = "simulation.dt_min", .section = "simulation", .type = KeyType::Number, .unit = "s",
+                  .range = kNonNegative,
+                  .doc = "only with `dt = \"adaptive\"`: a smaller step is a blow-up (the step collapsed); < `dt_max`",
+                  .default_doc = "1e-6 × the first step", .custom_read = true};
+  dt_min.get = [](const Scene& s) -> std::optional<KeyValue> {
+    if (!s.adaptive_dt) return std::nullopt;
+    return KeyValue{s.dt_min};
+  };
+  add(std::move(dt_min));
+  add(field(SceneKey{.key = "simulation.cfl", .section = "simulation", .range = kFraction,
+                     .doc = "C_cfl, SPH Δt ≤ C_cfl·h / (c + \\|v\\|max)"},
+            in_scene(&Scene::cfl)));
+  add(field(SceneKey{.key = "simulation.force_factor", .section = "simulation", .range = kFraction,
+                     .doc = "C_force, SPH Δt ≤ C_force·sqrt(h / \\|a\\|max)"},
+            in_scene(&Scene::force_factor)));
+  add(field(SceneKey{.key = "simulation.viscous_factor", .section = "simulation", .range = kFraction,
+                     .doc = "C_visc, SPH Δt ≤ C_visc·h²·ρ / μ"},
+            in_scene(&Scene::viscous_factor)));
+  add(field(SceneKey{.key = "simulation.eta", .section = "simulation", .range = Range{0, 10, true, false},
+                     .doc = "η, gravity Δt ≤ η·sqrt(ε / \\|a\\|max) (ε = 0: the mean particle spacing in place of ε)"},
+            in_scene(&Scene::eta)));
+
+  // [box]: the walls. A random box derives min and max itself.
+  const auto box_corner = [](Vec3d Box<double>::*corner) {
+    return [corner](auto& s) { return s.walls ? &(s.box.*corner) : nullptr; };
+  };
+  add(field(SceneKey{.key = "box.min", .section = "box", .unit = "m", .doc = "the low corner", .required = true},
+            box_corner(&Box<double>::lo)));
+  add(field(SceneKey{.key = "box.max", .section = "box", .unit = "m",
+                     .doc = "the high corner, greater than `min` on every axis", .required = true},
+            box_corner(&Box<double>::hi)));
+  add(field(SceneKey{.key = "box.restitution", .section = "box", .range = kUnit,
+                     .doc = "the fraction of its normal velocity a particle keeps when it hits a wall"},
+            [](auto& s) { return s.walls ? &s.restitution : nullptr; }));
+
+  // [forces]
+  add(field(SceneKey{.key = "forces.gravity", .section = "forces", .unit = "m/s²",
+                     .doc = "a uniform acceleration (use `[0, 0, 0]` for none)",
+                     .default_doc = "`[0, 0, -9.81]`, `[0, 0, 0]` with `[nbody]`",
+                     .context_default = [](const Scene& s) -> std::optional<KeyValue> {
+                       // A self-gravitating system floats in open space unless told otherwise.
+                       if (s.nbody) return KeyValue{Vec3d{}};
+                       return std::nullopt;
+                     }},
+            in_scene(&Scene::gravity)));
+  add(field(SceneKey{.key = "forces.damping", .section = "forces", .unit = "1/s", .range = kNonNegative,
+                     .doc = "γ of a drag a = −γ·v, for settling runs (0: none)"},
+            in_scene(&Scene::damping)));
+
+  // [sph]
+  add(field(SceneKey{.key = "sph.smoothing_length", .section = "sph", .unit = "m", .range = kSupport,
+                     .doc = "h, the kernel support and the hash cell length; exactly one of it and `neighbours`",
+                     .default_doc = "–", .custom_read = true},
+            in_sph(&sph::SphParameters::smoothing_length)));
+  add(SceneKey{.key = "sph.neighbours", .section = "sph", .type = KeyType::Number, .range = kNeighbourCount,
+               .doc = "h from a target neighbour count k and the spacing s of the first `fluid_block`, "
+                      "h = (3(k+1)s³/(4π))^(1/3)",
+               .default_doc = "–", .custom_read = true,
+               // Only a way to give h, which is hashed.
+               .get = [](const Scene&) -> std::optional<KeyValue> { return std::nullopt; }});
+  add(field(SceneKey{.key = "sph.rest_density", .section = "sph", .unit = "kg/m³", .range = kPositive, .doc = "ρ0"},
+            in_sph(&sph::SphParameters::rest_density)));
+  add(field(SceneKey{.key = "sph.sound_speed", .section = "sph", .unit = "m/s", .range = kPositive,
+                     .doc = "c in p = c²(ρ − ρ0)"},
+            in_sph(&sph::SphParameters::sound_speed)));
+  add(field(SceneKey{.key = "sph.viscosity", .section = "sph", .unit = "Pa·s", .range = kNonNegative, .doc = "μ"},
+            in_sph(&sph::SphParameters::viscosity)));
+  add(field(SceneKey{.key = "sph.pressure", .section = "sph", .noun = "pressure form",
+                     .doc = "`\"thesis\"` (eq. 2.8, applies ½∇p) or `\"consistent\"` (see docs/sph.md)"},
+            in_sph(&sph::SphParameters::pressure_form)));
+  add(field(SceneKey{.key = "sph.negative_pressure", .section = "sph", .noun = "negative pressure rule",
+                     .doc = "`\"keep\"` (eq. 2.9) or `\"zero\"` (no tension)"},
+            in_sph(&sph::SphParameters::negative_pressure)));
+  add(field(SceneKey{.key = "sph.neighbour_search", .section = "sph", .noun = "neighbour search",
+                     .doc = "`\"grid\"` (sorted cell grid, particles reordered in memory every step) or `\"hash\"` "
+                            "(the thesis's spatial hash); docs/sph.md"},
+            in_sph(&sph::SphParameters::neighbour_search)));
+  add(field(SceneKey{.key = "sph.grid.simd", .section = "sph",
+                     .doc = "grid: explicit SIMD passes; `false` runs their scalar twin (for comparison)"},
+            in_sph(&sph::SphParameters::simd)));
+  add(field(SceneKey{.key = "sph.grid.cell_order", .section = "sph", .noun = "cell order",
+                     .doc = "grid: `\"rows\"` (row-major cells, 9 ranges per cell) or `\"morton\"` (Z-order, up to 27); "
+                            "docs/performance/sph-grid.md"},
+            in_sph(&sph::SphParameters::cell_order)));
+  add(field(SceneKey{.key = "sph.grid.table", .section = "sph", .noun = "cell table",
+                     .doc = "grid: how cells are found: `\"dense\"` (a table over the box's cells), `\"hashed\"` (a hash "
+                            "table of the occupied cells, for particles spread over a huge region) or `\"auto\"` "
+                            "(dense while the box has at most 4·N + 4096 cell keys)"},
+            in_sph(&sph::SphParameters::cell_table)));
+  add(field(SceneKey{.key = "sph.grid.skin", .section = "sph", .unit = "m", .range = Range{0, 1e9, false, false},
+                     .doc = "grid: Verlet skin; cells of h + skin, the sort skipped until a particle moved more than "
+                            "skin/2 (0 = sort every evaluation)"},
+            in_sph(&sph::SphParameters::grid_skin)));
+  add(field(SceneKey{.key = "sph.hash.buckets", .section = "sph", .range = Range{0, 0xffffffffu, false, false},
+                     .doc = "0 = 1.6·N made odd (the thesis's table size), else the bucket count M"},
+            in_sph(&sph::SphParameters::buckets)));
+  add(field(SceneKey{.key = "sph.hash.duplicate_check", .section = "sph",
+                     .doc = "the thesis's cell-relation check against duplicate interactions"},
+            in_sph(&sph::SphParameters::duplicate_check)));
+
+  // [random_box] with the root key `particles`.
+  add(field(SceneKey{.key = "particles", .section = "random_box", .unit = "particles", .range = kParticleCount,
+                     .doc = "N, a root key in place of `[[particles]]`", .required = true, .custom_read = true},
+            in_random_box(&Scene::RandomBox::particles)));
+  add(field(SceneKey{.key = "random_box.neighbours", .section = "random_box", .range = kNeighbourCount, .doc = "k"},
+            in_random_box(&Scene::RandomBox::neighbors)));
+  add(field(SceneKey{.key = "random_box.seed", .section = "random_box", .range = kNonNegative,
+                     .doc = "seeds the positions"},
+            in_random_box(&Scene::RandomBox::seed)));
+
+  // [nbody]
+  using gravity::GravitySettings;
+  const auto linear_tree = [](const Scene& s) { return s.nbody && s.nbody->tree == gravity::Tree::linear; };
+  add(field(SceneKey{.key = "nbody.method", .section = "nbody", .noun = "method",
+                     .doc = "`\"barnes_hut\"` or `\"direct\"` (the exact O(N²) sum)"},
+            in_nbody(&GravitySettings::method)));
+  add(field(SceneKey{.key = "nbody.scheme", .section = "nbody", .noun = "scheme",
+                     .doc = "`\"subdomain\"`, `\"subtree\"` (the paper's 4.1, 4.2) or `\"global\"`"},
+            in_nbody(&GravitySettings::scheme)));
+  add(field(SceneKey{.key = "nbody.opening", .section = "nbody", .range = kUnit, .doc = "λ; 0 gives the direct sum"},
+            in_nbody(&GravitySettings::opening)));
+  add(field(SceneKey{.key = "nbody.softening", .section = "nbody", .unit = "length", .range = kNonNegative,
+                     .doc = "Plummer softening ε"},
+            in_nbody(&GravitySettings::softening)));
+  add(field(SceneKey{.key = "nbody.subdomain_size", .section = "nbody", .unit = "particles", .range = kAtLeastOne,
+                     .doc = "particles per local tree (subdomain)"},
+            in_nbody(&GravitySettings::subdomain_size)));
+  add(field(SceneKey{.key = "nbody.subtree_nodes", .section = "nbody", .unit = "nodes", .range = kAtLeastOne,
+                     .doc = "nodes per unit (subtree)"},
+            in_nbody(&GravitySettings::subtree_nodes)));
+  add(field(SceneKey{.key = "nbody.tree", .section = "nbody", .noun = "tree",
+                     .doc = "`\"linear\"` (the octree from sorted Morton keys) or `\"paper\"` (the paper's "
+                            "insertion-built tree); `\"linear\"` needs `scheme = \"global\"`",
+                     .default_doc = "`\"linear\"` with `scheme = \"global\"`, else `\"paper\"`",
+                     .context_default = [](const Scene& s) {
+                       const bool global = s.nbody && s.nbody->scheme == gravity::Scheme::global;
+                       return to_value(global ? gravity::Tree::linear : gravity::Tree::paper);
+                     }},
+            in_nbody(&GravitySettings::tree)));
+  add(field(SceneKey{.key = "nbody.multipole", .section = "nbody", .noun = "multipole",
+                     .doc = "`\"monopole\"` or `\"quadrupole\"`; the paper tree is monopole only",
+                     .default_doc = "`\"quadrupole\"` (linear tree), `\"monopole\"` (paper tree)",
+                     .context_default = [linear_tree](const Scene& s) {
+                       return to_value(linear_tree(s) ? gravity::Multipole::quadrupole : gravity::Multipole::monopole);
+                     }},
+            in_nbody(&GravitySettings::multipole)));
+  add(field(SceneKey{.key = "nbody.opening_criterion", .section = "nbody", .noun = "opening criterion",
+                     .doc = "`\"barnes\"` (open if d < l/θ + δ, θ = `opening`) or `\"paper\"` (open if l/d ≥ λ); the "
+                            "paper tree takes `\"paper\"` only",
+                     .default_doc = "`\"barnes\"` (linear tree), `\"paper\"` (paper tree)",
+                     .context_default = [linear_tree](const Scene& s) {
+                       return to_value(linear_tree(s) ? gravity::Criterion::barnes : gravity::Criterion::paper);
+                     }},
+            in_nbody(&GravitySettings::criterion)));
+  add(field(SceneKey{.key = "nbody.bucket_size", .section = "nbody", .unit = "particles", .range = kTreeSize,
+                     .doc = "a linear-tree node with more particles is split"},
+            in_nbody(&GravitySettings::bucket_size)));
+  add(field(SceneKey{.key = "nbody.walk", .section = "nbody", .noun = "walk",
+                     .doc = "`\"group\"` (one walk per group of ≤ `group_size` particles, its interaction list evaluated "
+                            "by the SIMD kernels) or `\"particle\"` (one walk per particle, the reference); the paper "
+                            "tree takes `\"particle\"` only",
+                     .default_doc = "`\"group\"` (linear tree), `\"particle\"` (paper tree)",
+                     .context_default = [linear_tree](const Scene& s) {
+                       return to_value(linear_tree(s) ? gravity::Walk::group : gravity::Walk::particle);
+                     }},
+            in_nbody(&GravitySettings::walk)));
+  add(field(SceneKey{.key = "nbody.group_size", .section = "nbody", .unit = "particles", .range = kTreeSize,
+                     .doc = "the group walk's groups hold at most this many particles (unless one leaf holds more); "
+                            "256–512 was fastest at the accuracy target (docs/performance/gravity-tree.md)"},
+            in_nbody(&GravitySettings::group_size)));
+  add(field(SceneKey{.key = "nbody.G", .section = "nbody", .unit = "length³/(mass·time²)", .range = kPositive,
+                     .doc = "the gravitational constant, in the scene's units",
+                     .default_doc = "`1` with `units = \"nbody\"`, `6.6743e-11` with `\"si\"`",
+                     .context_default = [](const Scene& s) {
+                       return to_value(s.units == Units::NBody ? 1.0 : kGravitationalConstantSI);
+                     }},
+            [](auto& s) { return s.nbody ? &s.gravitational_constant : nullptr; }));
+
+  // [output]
+  add(field(SceneKey{.key = "output.interval", .section = "output", .unit = "s (simulated)", .range = kNonNegative,
+                     .doc = "`0` writes only the first and the last frame"},
+            in_scene(&Scene::output_interval)));
+  add(field(SceneKey{.key = "output.format", .section = "output", .noun = "format",
+                     .doc = "each `\"vtp\"` (VTK XML PolyData, for ParaView) or `\"csv\"`; an array names at least "
+                            "one and none twice",
+                     .type_doc = "string or array of strings"},
+            in_scene(&Scene::formats)));
+  return k;
+}
+
+// ---- [[particles]] -----------------------------------------------------------
+
+SourceKey region_corner(std::string_view key, Vec3d Box<double>::*corner, std::string_view doc) {
+  SourceKey spec{.key = key, .type = KeyType::Vector, .unit = "m", .doc = doc, .required = true};
+  const auto locate = [corner](auto& src) {
+    using Pointer = decltype(&(std::get_if<LatticeSource>(&src)->region.*corner));  // const for a const source
+    if (auto* l = std::get_if<LatticeSource>(&src)) return Pointer{&(l->region.*corner)};
+    if (auto* r = std::get_if<RandomSource>(&src)) return Pointer{&(r->region.*corner)};
+    return Pointer{nullptr};
+  };
+  return field(std::move(spec), locate);
+}
+
+template <class Source>
+SourceKey seed_key(std::string_view doc) {
+  return field(SourceKey{.key = "seed", .range = kNonNegative, .doc = doc}, in_source(&Source::seed));
+}
+
+template <class Source>
+SourceKey velocity_key(std::string_view doc) {
+  return field(SourceKey{.key = "velocity", .unit = "m/s", .doc = doc}, in_source(&Source::velocity));
+}
+
+std::vector<SourceKey> lattice_keys(bool fluid) {
+  std::vector<SourceKey> k;
+  k.push_back(region_corner("min", &Box<double>::lo, "the region's low corner, inside the box"));
+  k.push_back(region_corner("max", &Box<double>::hi,
+                            "the region's high corner, inside the box, greater than `min` on every axis"));
+  k.push_back(field(SourceKey{.key = "spacing", .unit = "m", .range = kPositive, .doc = "the lattice constant",
+                              .required = true},
+                    in_source(&LatticeSource::spacing)));
+  k.push_back(field(SourceKey{.key = "jitter", .unit = "fraction of `spacing`", .range = Range{0, 0.5, false, true},
+                              .doc = "each coordinate moves by up to jitter·spacing"},
+                    in_source(&LatticeSource::jitter)));
+  k.push_back(seed_key<LatticeSource>("seeds the jitter"));
+  if (!fluid)
+    k.push_back(field(SourceKey{.key = "mass", .unit = "kg", .range = kPositive, .doc = "the mass of every particle",
+                                .required = true},
+                      in_source(&LatticeSource::mass)));
+  k.push_back(velocity_key<LatticeSource>("the initial velocity of every particle"));
+  return k;
+}
+
+std::vector<SourceKey> random_keys() {
+  std::vector<SourceKey> k;
+  k.push_back(region_corner("min", &Box<double>::lo, "the region's low corner, inside the box"));
+  k.push_back(region_corner("max", &Box<double>::hi,
+                            "the region's high corner, inside the box, greater than `min` on every axis"));
+  k.push_back(field(SourceKey{.key = "count", .range = kParticleCount, .doc = "the number of particles", .required = true},
+                    in_source(&RandomSource::count)));
+  k.push_back(seed_key<RandomSource>("seeds the positions"));
+  k.push_back(field(SourceKey{.key = "mass", .unit = "kg", .range = kPositive, .doc = "the mass of every particle",
+                              .required = true},
+                    in_source(&RandomSource::mass)));
+  k.push_back(velocity_key<RandomSource>("the initial velocity of every particle"));
+  return k;
+}
+
+std::vector<SourceKey> list_keys() {
+  std::vector<SourceKey> k;
+  k.push_back(field(SourceKey{.key = "positions", .unit = "m", .doc = "at least one; each inside the box",
+                              .required = true, .custom_read = true},
+                    in_source(&ListSource::positions)));
+  k.push_back(field(SourceKey{.key = "velocities", .unit = "m/s", .doc = "one per position",
+                              .default_doc = "all at rest", .custom_read = true},
+                    in_source(&ListSource::velocities)));
+  k.push_back(SourceKey{.key = "mass", .type = KeyType::Number, .unit = "kg", .range = kPositive,
+                        .doc = "the mass of every particle; exactly one of `mass` and `masses` is required",
+                        .default_doc = "–", .custom_read = true,
+                        // Stored as `masses`, one per position.
+                        .get = [](const ParticleSource&) -> std::optional<KeyValue> { return std::nullopt; }});
+  k.push_back(field(SourceKey{.key = "masses", .unit = "kg", .range = kPositive, .doc = "one per position",
+                              .default_doc = "–", .custom_read = true},
+                    in_source(&ListSource::masses)));
+  return k;
+}
+
+std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
+  using Model = StellarSource::Model;
+  std::vector<SourceKey> k;
+  k.push_back(field(SourceKey{.key = "count", .range = kParticleCount, .doc = "the number of particles",
+                              .required = true},
+                    in_source(&StellarSource::count)));
+  k.push_back(seed_key<StellarSource>("seeds the model"));
+  const auto plummer_cut = [](auto& src) { auto* m = std::get_if<StellarSource>(&src); return m ? &m->plummer.mass_cut : nullptr; };
+  const auto collision = [](auto member) {
+    return [member](auto& src) { auto* m = std::get_if<StellarSource>(&src); return m ? &(m->collision.*member) : nullptr; };
+  };
+  switch (model) {
+    case Model::Plummer:
+      k.push_back(field(SourceKey{.key = "mass_cut", .range = kFraction,
+                                  .doc = "the fraction of the infinite model's mass kept (its outskirts cut)"},
+                        plummer_cut));
+      break;
+    case Model::UniformSphere:
+    case Model::UniformCube:
+      k.push_back(field(SourceKey{.key = model == Model::UniformSphere ? "radius" : "side", .unit = "length",
+                                  .range = kPositive, .doc = "the size"},
+                        in_source(&StellarSource::size)));
+      k.push_back(field(SourceKey{.key = "mass", .unit = "mass", .range = kPositive, .doc = "the total mass"},
+                        in_source(&StellarSource::mass)));
+      break;
+    case Model::ColdCollapse: break;
+    case Model::PlummerCollision:
+      k.push_back(field(SourceKey{.key = "mass_fraction", .range = Range{0, 1, true, true},
+                                  .doc = "the first sphere's share of the particles and the mass"},
+                        collision(&gravity::CollisionOptions::mass_fraction)));
+      k.push_back(field(SourceKey{.key = "separation", .unit = "length", .range = kPositive,
+                                  .doc = "the spheres' initial distance"},
+                        collision(&gravity::CollisionOptions::separation)));
+      k.push_back(field(SourceKey{.key = "impact_parameter", .unit = "length", .range = kNonNegative,
+                                  .doc = "< `separation`",
+                                  .default_doc = "min(2, `separation`/5)",
+                                  .context_default = [](const ParticleSource& src) -> std::optional<KeyValue> {
+                                    const auto* m = std::get_if<StellarSource>(&src);
+                                    if (!m) return std::nullopt;
+                                    return KeyValue{std::min(2.0, 0.2 * m->collision.separation)};
+                                  }},
+                        collision(&gravity::CollisionOptions::impact_parameter)));
+      k.push_back(field(SourceKey{.key = "relative_velocity", .unit = "length/time", .range = kNonNegative,
+                                  .doc = "the spheres' initial relative speed", .default_doc = "parabolic"},
+                        collision(&gravity::CollisionOptions::relative_velocity)));
+      k.push_back(field(SourceKey{.key = "mass_cut", .range = kFraction, .doc = "of each sphere, as for `plummer`"},
+                        collision(&gravity::CollisionOptions::mass_cut)));
+      break;
+  }
+  k.push_back(field(SourceKey{.key = "offset", .unit = "length", .doc = "moves the whole model"},
+                    in_source(&StellarSource::offset)));
+  k.push_back(field(SourceKey{.key = "velocity", .unit = "length/time", .doc = "the whole model's bulk velocity"},
+                    in_source(&StellarSource::velocity)));
+  return k;
+}
+
+std::vector<SourceKind> declare_source_kinds() {
+  std::vector<SourceKind> kinds;
+  kinds.push_back({"lattice", "particles on a cubic lattice filling a region", lattice_keys(false), LatticeSource{}});
+  kinds.push_back({"random", "uniformly random positions in a region", random_keys(), RandomSource{}});
+  kinds.push_back({"list", "particles given one by one", list_keys(), ListSource{}});
+  kinds.push_back({"fluid_block",
+                   "a lattice whose mass makes an interior particle's SPH density exactly `sph.rest_density` (needs "
+                   "`[sph]`)",
+                   lattice_keys(true), LatticeSource{}});
+  for (const auto& model : kStellarModelNames) {
+    StellarSource prototype;
+    prototype.model = model.value;
+    kinds.push_back({model.name, "a self-gravitating model (open space only)", stellar_keys(model.value), prototype});
+  }
+  // Each key's docs table is its kind.
+  for (auto& kind : kinds)
+    for (auto& key : kind.keys) key.section = kind.name;
+  return kinds;
+}
+
+const std::vector<SceneKey>& scene_key_list() {
+  static const std::vector<SceneKey> keys = declare_scene_keys();
+  return keys;
+}
+
+const std::vector<SourceKind>& source_kind_list() {
+  static const std::vector<SourceKind> kinds = declare_source_kinds();
+  return kinds;
+}
+
+// ---- The docs' tables --------------------------------------------------------
+
+std::string_view type_text(KeyType type) {
+  switch (type) {
+    case KeyType::Number: return "number";
+    case KeyType::Integer: return "integer";
+    case KeyType::Boolean: return "boolean";
+    case KeyType::Name: return "string";
+    case KeyType::NameList: return "array of strings";
+    case KeyType::Vector: return "vector";
+    case KeyType::VectorList: return "array of vectors";
+    case KeyType::NumberList: return "array of numbers";
+  }
+  return "?";
+}
+
+// The constraint column: the range or the names, then the doc line.
+template <class Owner>
+std::string constraint_text(const KeySpec<Owner>& spec) {
+  std::string rule;
+  if (spec.type == KeyType::Number || spec.type == KeyType::NumberList || spec.type == KeyType::Vector ||
+      spec.type == KeyType::VectorList)
+    rule = "finite";
+  std::string range = spec.range.text();
+  if (!range.empty() && spec.type != KeyType::Vector && spec.type != KeyType::VectorList) {
+    // ">= 0" reads better as "≥ 0" in prose.
+    for (auto at = range.find(">="); at != std::string::npos; at = range.find(">=")) range.replace(at, 2, "≥");
+    for (auto at = range.find("<="); at != std::string::npos; at = range.find("<=")) range.replace(at, 2, "≤");
+    rule += (rule.empty() ? "" : ", ") + range;
+  }
+  if (!spec.names.empty()) {
+    std::string names;
+    for (std::size_t i = 0; i < spec.names.size(); ++i)
+      names += fmt::format("{}`\"{}\"`", i == 0 ? "" : i + 1 == spec.names.size() ? " or " : ", ", spec.names[i]);
+    // A name key's doc already explains each name when it quotes them.
+    if (spec.doc.find("`\"") == std::string_view::npos) rule += (rule.empty() ? "" : ", ") + names;
+  }
+  if (rule.empty()) return std::string(spec.doc);
+  return fmt::format("{}: {}", rule, spec.doc);
+}
+
+template <class Owner>
+std::string default_text(const KeySpec<Owner>& spec, const Owner& defaults) {
+  if (!spec.default_doc.empty()) return std::string(spec.default_doc);
+  if (spec.required) return "required";
+  const auto value = spec.get ? spec.get(defaults) : std::nullopt;
+  if (!value) return "–";
+  return fmt::format("`{}`", value_text(*value, false));
+}
+
+template <class Owner>
+std::string row(const KeySpec<Owner>& spec, std::string_view shown_key, const Owner& defaults) {
+  const std::string type = spec.type_doc.empty() ? std::string(type_text(spec.type)) : std::string(spec.type_doc);
+  return fmt::format("| `{}` | {} | {} | {} | {} |\n", shown_key, type, spec.unit.empty() ? "–" : spec.unit,
+                     default_text(spec, defaults), constraint_text(spec));
+}
+
+constexpr std::string_view kTableHeader = "| key | type | unit | default | constraint |\n|---|---|---|---|---|\n";
+
+// Every section with its fields present, so that each key's default shows.
+Scene scene_with_every_section() {
+  Scene s;
+  s.sph.emplace();
+  s.nbody.emplace();
+  s.random_box.emplace();
+  return s;
+}
+
+constexpr std::string_view kRegionOpen = "<!-- scene-keys:";
+constexpr std::string_view kRegionOpenEnd = " (generated by scene_keys_doc; do not edit) -->\n";
+constexpr std::string_view kRegionClose = "<!-- /scene-keys -->";
+
+}  // namespace
+
+std::span<const KeySpec<Scene>> scene_keys() { return scene_key_list(); }
+
+std::span<const std::string_view> scene_sections() {
+  static constexpr std::string_view sections[] = {"simulation", "box", "forces", "sph", "random_box",
+                                                  "nbody",      "output", "particles"};
+  return sections;
+}
+
+std::span<const SourceKind> source_kinds() { return source_kind_list(); }
+
+const SourceKind& kind_of(const ParticleSource& source) {
+  // The first kind of the same alternative (and model): a LatticeSource is a
+  // "lattice", declared before "fluid_block".
+  const auto same = [&](const SourceKind& kind) {
+    if (kind.prototype.index() != source.index()) return false;
+    const auto* model = std::get_if<StellarSource>(&source);
+    return !model || std::get<StellarSource>(kind.prototype).model == model->model;
+  };
+  const auto& kinds = source_kind_list();
+  const auto it = std::find_if(kinds.begin(), kinds.end(), same);
+  if (it == kinds.end()) throw std::logic_error("a particle source of no declared kind");
+  return *it;
+}
+
+std::string value_text(const KeyValue& value, bool exact) {
+  const auto number = [exact](double v) { return exact ? fmt::format("{:.17g}", v) : fmt::format("{}", v); };
+  const auto vec = [&](const Vec3d& v) { return fmt::format("[{}, {}, {}]", number(v.x), number(v.y), number(v.z)); };
+  return std::visit(
+      [&]<class T>(const T& v) -> std::string {
+        if constexpr (std::is_same_v<T, double>) return number(v);
+        else if constexpr (std::is_same_v<T, std::uint64_t>) return fmt::format("{}", v);
+        else if constexpr (std::is_same_v<T, bool>) return v ? "true" : "false";
+        else if constexpr (std::is_same_v<T, std::string_view>) return fmt::format("\"{}\"", v);
+        else if constexpr (std::is_same_v<T, Vec3d>) return vec(v);
+        else {
+          std::string out = "[";
+          for (std::size_t i = 0; i < v.size(); ++i) {
+            out += i ? ", " : "";
+            if constexpr (std::is_same_v<T, std::vector<std::string_view>>) out += fmt::format("\"{}\"", v[i]);
+            else if constexpr (std::is_same_v<T, std::vector<Vec3d>>) out += vec(v[i]);
+            else out += number(v[i]);
+          }
+          return out + "]";
+        }
+      },
+      value);
+}
+
+std::vector<std::string_view> key_table_sections() {
+  std::vector<std::string_view> out(scene_sections().begin(), scene_sections().end());
+  out.insert(out.begin(), "format");
+  for (const auto& kind : source_kinds()) out.push_back(kind.name);
+  return out;
+}
+
+std::string key_table_markdown(std::string_view section) {
+  std::string out(kTableHeader);
+  if (section == "particles") {
+    std::string kinds;
+    for (std::size_t i = 0; i < source_kinds().size(); ++i)
+      kinds += fmt::format("{}`\"{}\"`", i ? ", " : "", source_kinds()[i].name);
+    return out + fmt::format("| `kind` | string | – | required | {}: the kind of source, below |\n", kinds);
+  }
+  for (const auto& kind : source_kinds()) {
+    if (kind.name != section) continue;
+    for (const auto& spec : kind.keys) out += row(spec, spec.key, kind.prototype);
+    return out;
+  }
+  // A section of the scene; "format" stands for the root keys' table.
+  const bool root = section == "format";
+  if (!root && std::ranges::find(scene_sections(), section) == scene_sections().end())
+    throw std::runtime_error(fmt::format("no scene key table '{}'", section));
+  const std::string_view table = root ? std::string_view() : section;
+  const Scene defaults = scene_with_every_section();
+  for (const auto& spec : scene_keys()) {
+    if (spec.section != table) continue;
+    std::string_view shown = spec.key;
+    if (shown.starts_with(section) && shown.size() > section.size() && shown[section.size()] == '.')
+      shown.remove_prefix(section.size() + 1);
+    out += row(spec, shown, defaults);
+  }
+  return out;
+}
+
+std::string with_generated_key_tables(std::string_view markdown) {
+  std::string out;
+  std::vector<std::string_view> seen;
+  std::size_t at = 0;
+  for (;;) {
+    const std::size_t open = markdown.find(kRegionOpen, at);
+    if (open == std::string_view::npos) break;
+    const std::size_t name_start = open + kRegionOpen.size();
+    const std::size_t name_end = markdown.find(kRegionOpenEnd, name_start);
+    if (name_end == std::string_view::npos || markdown.substr(name_start, name_end - name_start).find('\n') != std::string_view::npos)
+      throw std::runtime_error(fmt::format("malformed region start at byte {}", open));
+    const std::string_view section = markdown.substr(name_start, name_end - name_start);
+    const std::size_t body = name_end + kRegionOpenEnd.size();
+    const std::size_t close = markdown.find(kRegionClose, body);
+    if (close == std::string_view::npos) throw std::runtime_error(fmt::format("region '{}' is not closed", section));
+    out += markdown.substr(at, body - at);
+    out += key_table_markdown(section);  // throws for an unknown section
+    seen.push_back(section);
+    at = close;
+  }
+  out += markdown.substr(at);
+  for (const auto section : key_table_sections())
+    if (std::ranges::find(seen, section) == seen.end())
+      throw std::runtime_error(fmt::format("no generated region for the key table '{}'", section));
+  return out;
+}
+
+}  // namespace swirl::scene

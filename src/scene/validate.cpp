@@ -1,0 +1,178 @@
+#include "swirl/scene/validate.hpp"
+
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "messages.hpp"
+#include "sources.hpp"
+#include "swirl/scene/keys.hpp"
+
+namespace swirl::scene {
+namespace {
+
+std::string count_text(std::uint64_t n) { return n == detail::kSaturated ? "over 1.8e19" : std::to_string(n); }
+
+class Checker {
+ public:
+  explicit Checker(const Scene& s) : s_(s), file_(s.file.empty() ? std::string("scene") : s.file) {}
+
+  [[noreturn]] void fail(std::string_view where, std::string_view reason) const { detail::fail(file_, where, reason); }
+
+  void keys() const {
+    // The format first: a newer scene's other keys may mean something else.
+    if (const std::string problem = detail::format_version_problem(s_.format_version); !problem.empty())
+      fail("format", problem);
+    for (const auto& spec : scene_keys())
+      if (const auto value = spec.get(s_)) detail::check_value(spec, *value, file_, spec.key);
+  }
+
+  void time() const {
+    if (s_.end_time && s_.steps) fail("simulation.steps", "cannot be given together with simulation.end_time; give one of them");
+    if (!s_.end_time && !s_.steps) fail("simulation.end_time", "missing required key (give end_time or simulation.steps)");
+    // total_steps() converts end_time / dt to an integer; it must fit.
+    if (s_.end_time && !s_.adaptive_dt && !(*s_.end_time / s_.dt <= 0x1p53))
+      fail("simulation.end_time", fmt::format("needs {:.3g} steps of dt = {}, more than the limit of 2^53",
+                                              *s_.end_time / s_.dt, s_.dt));
+    if (s_.adaptive_dt && !(s_.dt_min < s_.dt))
+      fail("simulation.dt_min", fmt::format("must be smaller than simulation.dt_max = {}, got {}", s_.dt, s_.dt_min));
+  }
+
+  // G is a key only with [nbody] (keys() checked it there), but a Scene built
+  // in code carries one anyway; whoever uses it may rely on G > 0.
+  void units() const {
+    if (!(s_.gravitational_constant > 0) || !std::isfinite(s_.gravitational_constant))
+      fail("nbody.G", fmt::format("must be finite and > 0, got {}", s_.gravitational_constant));
+  }
+
+  void box() const {
+    if (s_.walls) extent(s_.box, "box");
+  }
+
+  // The paper's schemes walk the paper's tree; only `global` can take the
+  // linear one, and only the linear tree has multipoles and Barnes' rule.
+  void nbody() const {
+    if (!s_.nbody) return;
+    const auto& g = *s_.nbody;
+    if (g.tree == gravity::Tree::linear && g.scheme != gravity::Scheme::global)
+      fail("nbody.tree", fmt::format("\"linear\" needs nbody.scheme = \"global\" (the paper's scheme \"{}\" walks the "
+                                     "paper's tree)",
+                                     gravity::to_string(g.scheme)));
+    if (g.tree == gravity::Tree::linear) return;
+    if (g.multipole != gravity::Multipole::monopole)
+      fail("nbody.multipole", "the paper's tree is monopole only (use tree = \"linear\" with scheme = \"global\")");
+    if (g.criterion != gravity::Criterion::paper)
+      fail("nbody.opening_criterion",
+           "the paper's tree uses the paper's rule only (use tree = \"linear\" with scheme = \"global\")");
+    if (g.walk != gravity::Walk::particle)
+      fail("nbody.walk", "the paper's tree walks per particle only (use tree = \"linear\" with scheme = \"global\")");
+  }
+
+  void sources() const {
+    if (s_.sources.empty()) fail("particles", "no particles: the scene needs at least one [[particles]] source");
+    std::uint64_t total = 0;
+    for (std::size_t i = 0; i < s_.sources.size(); ++i) {
+      const ParticleSource& source = s_.sources[i];
+      const std::string where = fmt::format("particles[{}]", i);
+      if (const auto* m = std::get_if<StellarSource>(&source);
+          m && enum_name<StellarSource::Model>(kStellarModelNames, m->model).empty())
+        fail(fmt::format("{}.kind", where), "is not a valid stellar model");
+      for (const auto& spec : kind_of(source).keys)
+        if (const auto value = spec.get(source))
+          detail::check_value(spec, *value, file_, fmt::format("{}.{}", where, spec.key));
+      if (const auto* l = std::get_if<LatticeSource>(&source)) lattice(*l, where);
+      else if (const auto* r = std::get_if<RandomSource>(&source)) region(r->region, where);
+      else if (const auto* list = std::get_if<ListSource>(&source)) listed(*list, where);
+      else stellar(std::get<StellarSource>(source), where);
+      const std::uint64_t n = detail::source_count(source);
+      if (n > detail::kMaxParticles)
+        fail(where, fmt::format("makes {} particles, more than the limit of {} (2^31); is the spacing too small?",
+                                count_text(n), detail::kMaxParticles));
+      total = detail::add_sat(total, n);
+    }
+    if (total == 0) fail("particles", "no particles: the scene needs at least one [[particles]] source");
+    if (total > detail::kMaxParticles)
+      fail("particles", fmt::format("the sources make {} particles in total, more than the limit of {} (2^31)",
+                                    count_text(total), detail::kMaxParticles));
+  }
+
+ private:
+  void extent(const Box<double>& b, std::string_view where) const {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (!(b.hi[axis] > b.lo[axis]))
+        fail(fmt::format("{}.max", where), fmt::format("must be greater than {}.min on every axis, but along {} {} <= {}",
+                                                       where, "xyz"[axis], b.hi[axis], b.lo[axis]));
+    }
+  }
+
+  void inside(const Vec3d& p, std::string_view where) const {
+    if (s_.walls && !s_.box.contains(p))
+      fail(where, fmt::format("{} lies outside the box {}", detail::vec_text(p), detail::box_text(s_.box)));
+  }
+
+  void region(const Box<double>& r, std::string_view where) const {
+    inside(r.lo, fmt::format("{}.min", where));
+    inside(r.hi, fmt::format("{}.max", where));
+    extent(r, where);
+  }
+
+  void lattice(const LatticeSource& l, std::string_view where) const {
+    region(l.region, where);
+    const auto n = detail::lattice_counts(l);
+    for (int axis = 0; axis < 3; ++axis) {
+      if (n[static_cast<std::size_t>(axis)] != 0) continue;
+      fail(where, fmt::format("makes no particles: the region is {} long along {}, less than the spacing {}",
+                              l.region.extent()[axis], "xyz"[axis], l.spacing));
+    }
+  }
+
+  void listed(const ListSource& l, std::string_view where) const {
+    const std::string positions = fmt::format("{}.positions", where);
+    if (l.positions.empty()) fail(positions, "must list at least one position");
+    for (std::size_t i = 0; i < l.positions.size(); ++i) inside(l.positions[i], fmt::format("{}[{}]", positions, i));
+    // Per-particle arrays must match positions one to one (velocities may be empty: all at rest).
+    if (!l.velocities.empty() && l.velocities.size() != l.positions.size())
+      fail(fmt::format("{}.velocities", where),
+           fmt::format("has {} entries but {} has {}", l.velocities.size(), positions, l.positions.size()));
+    if (l.masses.size() != l.positions.size())
+      fail(fmt::format("{}.masses", where),
+           fmt::format("has {} entries but {} has {}", l.masses.size(), positions, l.positions.size()));
+  }
+
+  void stellar(const StellarSource& m, std::string_view where) const {
+    const std::string_view kind = enum_name<StellarSource::Model>(kStellarModelNames, m.model);
+    if (s_.walls)
+      fail(fmt::format("{}.kind", where),
+           fmt::format("'{}' is a self-gravitating model: it needs open space (no [box])", kind));
+    if (m.model != StellarSource::Model::PlummerCollision) return;
+    const auto& c = m.collision;
+    const auto key = [&](std::string_view k) { return fmt::format("{}.{}", where, k); };
+    if (m.count < 2) fail(key("count"), "a collision needs at least 2 particles");
+    if (!(c.impact_parameter < c.separation))
+      fail(key("impact_parameter"), fmt::format("must be in [0, {}), got {}", c.separation, c.impact_parameter));
+    // Each sphere needs a particle, and the geometry (d², the parabolic speed √(2/d)) must stay finite.
+    const double n1 = std::round(c.mass_fraction * static_cast<double>(m.count));
+    if (n1 < 1 || n1 > static_cast<double>(m.count) - 1)
+      fail(key("mass_fraction"), fmt::format("{} of {} particles leaves one sphere empty", c.mass_fraction, m.count));
+    if (!std::isfinite(c.separation * c.separation) || !std::isfinite(std::sqrt(2.0 / c.separation)))
+      fail(key("separation"), fmt::format("{} is out of the usable range", c.separation));
+  }
+
+  const Scene& s_;
+  std::string file_;
+};
+
+}  // namespace
+
+void validate(const Scene& scene) {
+  const Checker check(scene);
+  check.keys();
+  check.time();
+  check.units();
+  check.box();
+  check.nbody();
+  check.sources();
+}
+
+}  // namespace swirl::scene
