@@ -39,9 +39,11 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    // CLI11 prints help, the version or the error; its own exit codes (104,
-    // 105, 109, ...) become the documented 2 for every usage error.
-    return app.exit(e) == 0 ? 0 : 2;
+    // Help and the version are CLI11's to print (status 0). Every usage error
+    // exits with the documented 2, not CLI11's own codes (104, 105, 109, ...).
+    if (e.get_exit_code() == 0) return app.exit(e);
+    fmt::print(stderr, "swirl: error: {}\nRun with --help for more information.\n", e.what());
+    return 2;
   }
 
   try {

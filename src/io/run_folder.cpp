@@ -189,7 +189,7 @@ fs::path RunFolder::relative(const fs::path& path) const {
   return rel;
 }
 
-fs::path RunFolder::claim(const fs::path& path) {
+fs::path RunFolder::claim(const fs::path& path, bool sync) {
   const fs::path rel = relative(path);
   const fs::path full = dir_ / rel;
   if (files_.count(rel)) return full;
@@ -204,7 +204,7 @@ fs::path RunFolder::claim(const fs::path& path) {
   }
   files_.insert(rel);
   try {
-    write_manifest();  // listed before it is written: the manifest never misses a file of this run
+    write_manifest(sync);  // listed before it is written: the manifest never misses a file of this run
   } catch (...) {
     files_.erase(rel);
     throw;
@@ -231,11 +231,11 @@ bool RunFolder::remove(const fs::path& path) {
   return true;
 }
 
-void RunFolder::write_manifest() const {
+void RunFolder::write_manifest(bool sync) const {
   std::string text = "# swirl run manifest: the files this run wrote, relative to this folder\n";
   text += fmt::format("run {}\n", identity_);
   for (const auto& f : files_) text += fmt::format("file {}\n", f.string());
-  write_file_atomic(dir_ / kManifestFile, text);
+  write_file_atomic(dir_ / kManifestFile, text, sync);
 }
 
 void check_distinct_outputs(std::span<const NamedOutput> outputs, std::span<const NamedOutput> inputs) {

@@ -95,7 +95,7 @@ TEST_F(RunFolderTest, ResumeAdoptsTheManifestAndPrunesOnlyItsOwnFiles) {
   {
     RunFolder first(out, RunFolderMode::Fresh, "scene");
     identity = first.identity();
-    spit(first.claim("checkpoints/checkpoint_000000000001.swc"), "mine");
+    spit(first.claim("checkpoints/checkpoint_000000000001.swc", /*sync=*/true), "mine");
   }
   spit(out / "checkpoints" / "checkpoint_000000000002.swc", "someone else's");
   RunFolder resumed(out, RunFolderMode::Resume, "ignored");

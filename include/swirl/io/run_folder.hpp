@@ -63,8 +63,9 @@ class RunFolder {
   // Call before writing `path`: returns its
   // full path, after recording it in the manifest. RunFolderError if it lies
   // outside dir(), or exists and is not this run's. Directories on the way are
-  // created.
-  std::filesystem::path claim(const std::filesystem::path& path);
+  // created. With `sync` the manifest is fsync'ed (claim a checkpoint so: a
+  // resume after a power cut then still knows it is this run's).
+  std::filesystem::path claim(const std::filesystem::path& path, bool sync = false);
   // Whether the manifest lists `path`.
   bool owns(const std::filesystem::path& path) const;
   // Deletes `path` if it is this run's and drops it from the manifest (e.g. a
@@ -75,7 +76,7 @@ class RunFolder {
 
  private:
   std::filesystem::path relative(const std::filesystem::path& path) const;
-  void write_manifest() const;
+  void write_manifest(bool sync = false) const;
 
   std::filesystem::path dir_;
   int lock_fd_ = -1;
