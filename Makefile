@@ -14,21 +14,27 @@ JOBS     ?= $(shell nproc)
 DEMO     ?= examples/dam_break.toml
 DEMO_OUT ?= out/demo
 
-# Debian 12 packages needed to build and test swirl.
-DEB_PACKAGES := cmake ninja-build g++ make git pkg-config \
-                libtomlplusplus-dev libcli11-dev libfmt-dev \
-                libgtest-dev libbenchmark-dev libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core \
-                python3-matplotlib
+# Debian 12 packages: what building the swirl tool needs (all `make demo`
+# installs; FreeType, libpng and the font are for `swirl render`, which is part
+# of the tool), and what only the tests, micro-benchmarks and bench plots need.
+DEB_BUILD_PACKAGES := cmake ninja-build g++ make git pkg-config \
+                      libtomlplusplus-dev libcli11-dev libfmt-dev \
+                      libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core
+DEB_TEST_PACKAGES  := libgtest-dev libbenchmark-dev python3-matplotlib
+DEB_PACKAGES       := $(DEB_BUILD_PACKAGES) $(DEB_TEST_PACKAGES)
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps configure build test unit-test demo bench asan-test tsan-test fuzz debug clean
+.PHONY: all deps deps-build configure build test unit-test demo bench asan-test tsan-test fuzz debug clean
 
 all: build
 
-deps:
+# deps-build installs what building the tool needs; deps adds the test-only packages.
+deps: PACKAGES = $(DEB_PACKAGES)
+deps-build: PACKAGES = $(DEB_BUILD_PACKAGES)
+deps deps-build:
 	@missing=""; \
-	for p in $(DEB_PACKAGES); do \
+	for p in $(PACKAGES); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
 	done; \
 	if [ -n "$$missing" ]; then \
@@ -49,8 +55,13 @@ unit-test: build
 	ctest --preset $(PRESET)
 	bash tools/check_simd_objects.sh build$(if $(filter-out release,$(PRESET)),-$(PRESET))
 
-demo: build
-	./build/swirl run $(DEMO) --out $(DEMO_OUT)
+# The demo builds only the tool, in its own tree (preset demo: release, tests
+# off, build-demo/), so a fresh machine neither installs nor compiles the test
+# suite and micro-benchmarks it does not run.
+demo: deps-build
+	cmake --preset demo
+	cmake --build --preset demo -j $(JOBS) --target swirl_cli
+	./build-demo/swirl run $(DEMO) --out $(DEMO_OUT)
 	@echo "Open $(DEMO_OUT)/particles.pvd in ParaView."
 
 # The seeds' experiments at their default sizes (each suite's CSV, JSON,
@@ -81,4 +92,4 @@ debug: deps
 	cmake --build --preset debug -j $(JOBS)
 
 clean:
-	rm -rf build build-debug build-asan build-tsan build-fuzz build-portable out
+	rm -rf build build-demo build-debug build-asan build-tsan build-fuzz build-portable out

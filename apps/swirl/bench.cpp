@@ -15,6 +15,8 @@
 
 #include "bench.hpp"
 #include "commands.hpp"
+#include "flags.hpp"
+#include "swirl/io/atomic_file.hpp"
 
 namespace swirl::cli {
 namespace {
@@ -42,9 +44,11 @@ CLI::App* add_suite(CLI::App* bench, Commands& commands, const std::string& name
   cmd->add_option("--out", common->out, fmt::format("Output directory for CSV, JSON, markdown and PNG plots (default bench/results/{})", name));
   cmd->add_option("--threads", common->threads, "Thread counts (default 1 .. all processors)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
+      ->check(thread_count());
   cmd->add_flag("--quick", common->quick, "Tiny fixed sizes and step counts (replacing the size flags), seconds in all: checks the pipeline (CI), measures nothing");
-  commands.push_back({cmd, [common, action = std::move(action)] {
+  commands.push_back({cmd, [common, name, action = std::move(action)] {
+                        // Checked before measuring, not after: a bad --out must not cost the measurements.
+                        io::ensure_writable_directory(bench::output_dir(*common, name));
                         common->command_line = command_line();
                         return action();
                       }});
@@ -62,52 +66,52 @@ void add_bench_commands(CLI::App& app, Commands& commands) {
   auto* c = add_suite(bench_cmd, commands, "sph-table",
                       "SPH random box: the thesis's Tables 5.1, 5.3 and Figures 5.2, 5.3, 5.5, 5.7", common,
                       [sph, common] { return bench::run_sph_table(*sph, *common); });
-  c->add_option("--sizes", sph->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
+  c->add_option("--sizes", sph->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
   c->add_option("--neighbours", sph->neighbours, "Measured neighbours per particle to aim at")
       ->delimiter(',')
-      ->check(CLI::Range(1.0, 500.0));
+      ->check(number_in(1.0, 500.0));
   c->add_option("--strategy", sph->strategies,
                 "Neighbour search(es): sph.neighbour_search values, the grid's with options, e.g. "
                 "grid+morton+hashed+skin=0.1h (+rows|morton, +dense|hashed, +skin=X or Xh; default: the scene's)")
       ->delimiter(',');
   c->add_option("--settle", sph->settle, "Steps to settle the random start before timing (the thesis: 3000)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(whole_number(0, kMaxCount));
   c->add_option("--steps", sph->steps, "Timed steps (default: about 2e6 particle-steps, 20 .. 1000)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxCount));
 
   auto hs = std::make_shared<bench::HashStatsArgs>();
   c = add_suite(bench_cmd, commands, "hash-stats",
                 "Hash table statistics (the thesis's Table 5.2) and the cost of the duplicate check", common,
                 [hs, common] { return bench::run_hash_stats(*hs, *common); });
-  c->add_option("--particles", hs->particles, "Particles")->check(CLI::PositiveNumber);
-  c->add_option("--neighbours", hs->neighbours, "Measured neighbours to aim at")->check(CLI::Range(1.0, 500.0));
-  c->add_option("--buckets", hs->buckets, "Hash table size")->check(CLI::PositiveNumber);
-  c->add_option("--settle", hs->settle, "Steps to settle before measuring")->check(CLI::NonNegativeNumber);
-  c->add_option("--steps", hs->steps, "Timed steps per setting")->check(CLI::PositiveNumber);
+  c->add_option("--particles", hs->particles, "Particles")->check(whole_number(1, kMaxCount));
+  c->add_option("--neighbours", hs->neighbours, "Measured neighbours to aim at")->check(number_in(1.0, 500.0));
+  c->add_option("--buckets", hs->buckets, "Hash table size")->check(whole_number(1, kMaxCount));
+  c->add_option("--settle", hs->settle, "Steps to settle before measuring")->check(whole_number(0, kMaxCount));
+  c->add_option("--steps", hs->steps, "Timed steps per setting")->check(whole_number(1, kMaxCount));
 
   auto bt = std::make_shared<bench::BhTableArgs>();
   c = add_suite(bench_cmd, commands, "bh-table", "Barnes-Hut: the paper's Table 2 and Figures 9-13", common,
                 [bt, common] { return bench::run_bh_table(*bt, *common); });
-  c->add_option("--sizes", bt->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
+  c->add_option("--sizes", bt->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
   c->add_option("--schemes", bt->schemes, "subdomain,subtree,global")->delimiter(',');
-  c->add_option("--iterations", bt->iterations, "Iterations")->check(CLI::PositiveNumber);
-  c->add_option("--opening", bt->opening, "Opening criterion lambda")->check(CLI::Range(0.0, 1.0));
+  c->add_option("--iterations", bt->iterations, "Iterations")->check(whole_number(1, kMaxCount));
+  c->add_option("--opening", bt->opening, "Opening criterion lambda")->check(number_in(0.0, 1.0));
 
   auto bl = std::make_shared<bench::BhLambdaArgs>();
   c = add_suite(bench_cmd, commands, "bh-lambda", "Barnes-Hut: lambda against time and force error (Figures 14-15)",
                 common, [bl, common] { return bench::run_bh_lambda(*bl, *common); });
-  c->add_option("--sizes", bl->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
-  c->add_option("--lambdas", bl->openings, "Opening criteria")->delimiter(',')->check(CLI::Range(0.0, 1.0));
+  c->add_option("--sizes", bl->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
+  c->add_option("--lambdas", bl->openings, "Opening criteria")->delimiter(',')->check(number_in(0.0, 1.0));
   c->add_option("--schemes", bl->schemes, "subdomain,subtree,global")->delimiter(',');
-  c->add_option("--iterations", bl->iterations, "Iterations")->check(CLI::PositiveNumber);
+  c->add_option("--iterations", bl->iterations, "Iterations")->check(whole_number(1, kMaxCount));
 
   auto bp = std::make_shared<bench::BhPhasesArgs>();
   c = add_suite(bench_cmd, commands, "bh-phases", "Barnes-Hut: time per phase beside the paper's Table 1", common,
                 [bp, common] { return bench::run_bh_phases(*bp, *common); });
-  c->add_option("--sizes", bp->sizes, "Particle counts")->delimiter(',')->check(CLI::PositiveNumber);
+  c->add_option("--sizes", bp->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
   c->add_option("--schemes", bp->schemes, "subdomain,subtree,global")->delimiter(',');
-  c->add_option("--iterations", bp->iterations, "Iterations")->check(CLI::PositiveNumber);
-  c->add_option("--opening", bp->opening, "Opening criterion lambda")->check(CLI::Range(0.0, 1.0));
+  c->add_option("--iterations", bp->iterations, "Iterations")->check(whole_number(1, kMaxCount));
+  c->add_option("--opening", bp->opening, "Opening criterion lambda")->check(number_in(0.0, 1.0));
 
   // Further suites register here (one line each).
   add_bench_bh_scale(*bench_cmd, commands);

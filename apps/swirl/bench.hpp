@@ -15,6 +15,7 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -94,6 +95,9 @@ struct SuiteReport {
   std::string notes;  // markdown after the tables: set-up, provenance, how figures map
   std::vector<Plot> plots;
 };
+
+// The output directory of `suite`: --out, or its default.
+std::filesystem::path output_dir(const CommonArgs& args, const std::string& suite);
 
 // Prints the report to stdout and writes its files (atomically) into the
 // output directory. Plots that cannot be drawn (no /usr/bin/python3 with

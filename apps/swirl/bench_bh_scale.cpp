@@ -29,6 +29,8 @@
 
 #include "bench.hpp"
 #include "commands.hpp"
+#include "flags.hpp"
+#include "swirl/io/atomic_file.hpp"
 #include "swirl/gravity/barnes_hut.hpp"
 #include "swirl/gravity/initial_conditions.hpp"
 #include "swirl/gravity/pair_law.hpp"
@@ -308,31 +310,32 @@ void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands) {
                                                  "sampled force error, interactions and bytes per particle");
   c->add_option("--sizes", args->sizes, "Particle counts (default 4096,...,8388608)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxCount));
   c->add_option("--threads", common->threads, "Thread counts (default 1 .. all processors)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
-  c->add_option("--sample", args->sample, "Particles sampled for the force error")->check(CLI::PositiveNumber);
+      ->check(thread_count());
+  c->add_option("--sample", args->sample, "Particles sampled for the force error")->check(whole_number(1, kMaxCount));
   c->add_option("--opening", args->openings, "theta (barnes) or lambda (paper); a list is a dimension")
       ->delimiter(',')
-      ->check(CLI::Range(0.0, 1.0));
-  c->add_option("--softening", args->softening, "epsilon")->check(CLI::NonNegativeNumber);
+      ->check(number_in(0.0, 1.0));
+  c->add_option("--softening", args->softening, "epsilon")->check(non_negative_finite());
   c->add_option("--multipoles", args->multipoles, "monopole,quadrupole")->delimiter(',');
   c->add_option("--criteria", args->criteria, "paper,barnes")->delimiter(',');
   c->add_option("--walks", args->walks, "group,particle (default group)")->delimiter(',');
   c->add_option("--bucket", args->buckets, "Particles per leaf at most (a list is a dimension)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxCount));
   c->add_option("--group-sizes", args->group_sizes, "Group walk: particles per group at most (default: GravitySettings, 256)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxCount));
   c->add_option("--repeats", args->repeats, "Timed evaluations per point (default 3 below 2^19, else 1)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxCount));
   c->add_option("--precision", args->precisions, "double,float (default double)")->delimiter(',');
   c->add_option("--seed", args->seed, "Seed of the Plummer sphere and the sample");
   c->add_option("--out", common->out, "Output directory for CSV, JSON, markdown and PNG plots (default bench/bh-scale)");
   c->add_flag("--quick", common->quick, "Tiny sizes: checks the pipeline (CI), measures nothing");
   commands.push_back({c, [args, common] {
+                        io::ensure_writable_directory(bench::output_dir(*common, "bh-scale"));
                         common->command_line = command_line();
                         return run_bh_scale(*args, *common);
                       }});

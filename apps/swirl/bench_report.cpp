@@ -276,11 +276,15 @@ void progress(const std::string& line) {
   std::fflush(stderr);
 }
 
-int publish(const SuiteReport& r, const CommonArgs& args) {
+fs::path output_dir(const CommonArgs& args, const std::string& suite) {
   // By default a real run replaces the committed results; a quick one never does.
-  const fs::path dir = !args.out.empty() ? fs::path(args.out)
-                       : args.quick      ? fs::path("out") / "bench-quick" / r.suite
-                                         : fs::path("bench") / "results" / r.suite;
+  return !args.out.empty() ? fs::path(args.out)
+         : args.quick      ? fs::path("out") / "bench-quick" / suite
+                           : fs::path("bench") / "results" / suite;
+}
+
+int publish(const SuiteReport& r, const CommonArgs& args) {
+  const fs::path dir = output_dir(args, r.suite);
   io::ensure_writable_directory(dir);
   const std::string date = utc_now(), cpu = cpu_model();
   const int processors = omp_get_num_procs();

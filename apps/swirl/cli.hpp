@@ -3,8 +3,10 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <span>
 #include <string>
 
+#include "swirl/scene/scene.hpp"
 #include "swirl/sim/run.hpp"
 
 namespace swirl::cli {
@@ -24,6 +26,10 @@ class ProgressDisplay {
   double last_shown_ = -1e300;
   bool drawn_ = false;
 };
+
+// A scene file read by io::read_regular_file (a FIFO or device is refused, not
+// waited on; at most io::kMaxSceneBytes) and parsed with the overrides.
+scene::Scene load_scene_file(const std::filesystem::path& file, std::span<const std::string> overrides = {});
 
 // The closing summary as aligned text lines.
 std::string summary_text(const sim::RunSummary& s);

@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 
 #include "bench_seeds.hpp"
+#include "cli.hpp"
 #include "commands.hpp"
+#include "flags.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/hash_stats.hpp"
@@ -24,7 +26,7 @@ struct HashStatsArgs {
 
 // Table 5.2 of the thesis, beside this run's figures.
 int hash_stats(const HashStatsArgs& args) {
-  const auto scene = scene::load_scene(args.scene, args.overrides);
+  const auto scene = load_scene_file(args.scene, args.overrides);
   sim::check_memory(scene);  // before the particles are built, as `swirl run` does
   if (args.threads > 0) parallel::set_thread_count(args.threads);
   const auto s = sim::scene_hash_statistics(scene, args.steps);
@@ -56,8 +58,9 @@ void add_hash_stats_command(CLI::App& app, Commands& commands) {
   auto* hash_cmd = app.add_subcommand("hash-stats", "Print the spatial hash statistics of an SPH scene (Table 5.2)");
   hash_cmd->add_option("scene", hs->scene, "Scene file (TOML) with an [sph] section")->required();
   hash_cmd->add_option("--set", hs->overrides, "Override a scene key")->type_name("KEY=VALUE");
-  hash_cmd->add_option("--steps", hs->steps, "Run N steps before measuring (default: the initial positions)");
-  hash_cmd->add_option("--threads,-t", hs->threads, "Threads")->check(CLI::PositiveNumber);
+  hash_cmd->add_option("--steps", hs->steps, "Run N steps before measuring (default: the initial positions)")
+      ->check(whole_number(0, kMaxSteps));
+  hash_cmd->add_option("--threads,-t", hs->threads, "Threads")->check(thread_count());
   commands.push_back({hash_cmd, [hs] { return hash_stats(*hs); }});
 }
 

@@ -6,8 +6,9 @@
 //   swirl info                                               (info_command.cpp)
 //   swirl render RUN_DIR [options]                           (render_command.cpp)
 //
-// Exit status: 0 done, 1 the run failed (blow-up, write error), 2 bad input,
-// 130 / 143 stopped by SIGINT / SIGTERM after writing a checkpoint.
+// Exit status: 0 done, 1 the run failed (blow-up, write error; render: frames
+// missing), 2 bad input (every usage error, whatever CLI11's own code), 130 /
+// 143 stopped by SIGINT / SIGTERM after writing a checkpoint.
 #include <csignal>
 #include <exception>
 #include <string>
@@ -17,6 +18,7 @@
 
 #include "commands.hpp"
 #include "swirl/core/simd_dispatch.hpp"
+#include "swirl/parallel/for_blocks.hpp"
 #include "swirl/config.hpp"
 #include "swirl/scene/load.hpp"
 
@@ -37,10 +39,17 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // Help and the version are CLI11's to print (status 0). Every usage error
+    // exits with the documented 2, not CLI11's own codes (104, 105, 109, ...).
+    if (e.get_exit_code() == 0) return app.exit(e);
+    fmt::print(stderr, "swirl: error: {}\nRun with --help for more information.\n", e.what());
+    return 2;
   }
 
   try {
+    // Before any parallel loop: OpenMP would start every thread OMP_NUM_THREADS asks for.
+    if (const std::string w = swirl::parallel::clamp_default_thread_count(); !w.empty())
+      fmt::print(stderr, "swirl: warning: {}\n", w);
     swirl::simd::active();  // a bad SWIRL_SIMD stops here, before any work
     for (const auto& command : commands)
       if (command.app->parsed()) return command.action();

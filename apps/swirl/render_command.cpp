@@ -7,6 +7,7 @@
 // Without --frame or --all the last frame is drawn. Pictures go to
 // RUN_DIR/render/particles_NNNNNN.png (or --out DIR), the movie to
 // DIR/movie.mp4. Every file is written atomically.
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -15,8 +16,10 @@
 #include <vector>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "commands.hpp"
+#include "flags.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/render/movie.hpp"
@@ -59,10 +62,11 @@ std::pair<double, double> parse_range(const std::string& text) {
     std::size_t used_lo = 0, used_hi = 0;
     if (sep == std::string::npos) throw std::invalid_argument("");
     const double lo = std::stod(text.substr(0, sep), &used_lo), hi = std::stod(text.substr(sep + 1), &used_hi);
-    if (used_lo != sep || used_hi != text.size() - sep - 1) throw std::invalid_argument("");
+    if (used_lo != sep || used_hi != text.size() - sep - 1 || !std::isfinite(lo) || !std::isfinite(hi))
+      throw std::invalid_argument("");
     return {lo, hi};
   } catch (const std::logic_error&) {
-    throw std::invalid_argument("--range '" + text + "': expected LO,HI, e.g. 0,3.5");
+    throw std::invalid_argument("--range '" + text + "': expected LO,HI (finite numbers), e.g. 0,3.5");
   }
 }
 
@@ -90,7 +94,19 @@ int render(const RenderArgs& args) {
   } else if (!args.all && !args.movie) {
     frames = {frames.back()};
   }
-  // Options are checked and frame 0 read before the output folder is made.
+  // A frame listed in the series but missing on disk is named at the end, not
+  // a reason to stop drawing the others; the camera is fitted to the first
+  // frame that exists.
+  const auto on_disk = [&](const io::PvdEntry& f) { return fs::is_regular_file(fs::path(args.run_dir) / f.file); };
+  std::vector<std::string> missing;
+  for (const auto& f : frames)
+    if (!on_disk(f)) missing.push_back(f.file);
+  std::erase_if(frames, [&](const io::PvdEntry& f) { return !on_disk(f); });
+  if (frames.empty())
+    throw io::IoError(fmt::format("{}: frame file{} missing: {}; nothing to draw", args.run_dir,
+                                  missing.size() == 1 ? " is" : "s are", fmt::join(missing, ", ")));
+  std::erase_if(run.frames, [&](const io::PvdEntry& f) { return !on_disk(f); });
+  // Options are checked and the first frame read before the output folder is made.
   const render::RunRenderer renderer(std::move(run), options);
   const fs::path out = args.out.empty() ? fs::path(args.run_dir) / "render" : fs::path(args.out);
   io::ensure_writable_directory(out);
@@ -110,6 +126,12 @@ int render(const RenderArgs& args) {
     fmt::print("swirl render: wrote {} ({})\n", written.front().string(), colours);
   else
     fmt::print("swirl render: wrote {} frames to {} ({})\n", written.size(), out.string(), colours);
+  if (!missing.empty()) {
+    fmt::print(stderr, "swirl render: {} frame{} missing from {}, not drawn: {}\n", missing.size(),
+               missing.size() == 1 ? " is" : "s are", args.run_dir, fmt::join(missing, ", "));
+    if (args.movie) fmt::print(stderr, "swirl render: no movie: it would skip the missing frames\n");
+    return 1;
+  }
   if (args.movie) {
     const fs::path movie = out / "movie.mp4";
     render::make_movie(written, movie, args.fps);
@@ -124,7 +146,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
   auto args = std::make_shared<RenderArgs>();
   auto* cmd = app.add_subcommand("render", "Draw a run's frames as PNG pictures (and an MP4 movie with ffmpeg)");
   cmd->add_option("run_dir", args->run_dir, "Run directory (holds particles.pvd and the .vtp frames)")->required();
-  auto* frame = cmd->add_option("--frame", args->frame, "Draw frame K (default: the last)")->check(CLI::NonNegativeNumber);
+  auto* frame = cmd->add_option("--frame", args->frame, "Draw frame K (default: the last)")
+                    ->check(whole_number(0, std::uint64_t{1} << 62));
   cmd->add_flag("--all", args->all, "Draw every frame")->excludes(frame);
   cmd->add_option("--view", args->view, "front (along y), top (along -z) or iso")->check(CLI::IsMember({"front", "top", "iso"}));
   cmd->add_option("--projection", args->projection, "ortho or perspective (default: perspective for iso)")
@@ -135,9 +158,9 @@ void add_render_command(CLI::App& app, Commands& commands) {
   cmd->add_option("--range", args->range, "Colour range LO,HI (log10 of the surface density for gravity runs)");
   cmd->add_option("--out,-o", args->out, "Where the pictures go (default: RUN_DIR/render)");
   cmd->add_flag("--movie", args->movie, "Also make DIR/movie.mp4 of every frame with ffmpeg (implies --all)")->excludes(frame);
-  cmd->add_option("--fps", args->fps, "Movie frames per second (default 25)")->check(CLI::PositiveNumber);
+  cmd->add_option("--fps", args->fps, "Movie frames per second (default 25)")->check(whole_number(1, 1000));
   cmd->add_option("--threads,-t", args->threads, "Threads (default: all cores); pictures are identical for any count")
-      ->check(CLI::PositiveNumber);
+      ->check(thread_count());
   commands.push_back({cmd, [args] { return render(*args); }});
 }
 

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <csignal>
 #include <memory>
@@ -18,7 +19,9 @@
 
 #include "cli.hpp"
 #include "commands.hpp"
+#include "flags.hpp"
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/run_folder.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/run.hpp"
 #include "swirl/render/font.hpp"
@@ -53,6 +56,35 @@ extern "C" void on_signal(int sig) {
   g_signal.store(sig);
 }
 
+// Every output path the command was given, checked before the first step
+// (not after the run, when a typo would cost the whole run): each can be
+// written, none is another's file, none is the scene being read.
+void check_outputs(const RunArgs& args, const std::filesystem::path& out_dir) {
+  namespace fs = std::filesystem;
+  std::vector<io::NamedOutput> outputs{{"--out", out_dir / "scene.toml"}}, inputs;
+  if (!args.scene.empty()) inputs.push_back({"scene file", args.scene});
+  if (!args.summary_json.empty()) {
+    const fs::path json = args.summary_json;
+    // The run writes these names in its folder: the summary must not land on one.
+    const fs::path rel = fs::absolute(json).lexically_normal().lexically_relative(fs::absolute(out_dir).lexically_normal());
+    const std::string name = rel.string();
+    if (rel.has_parent_path() ? rel.begin()->string() == "checkpoints" || rel.begin()->string() == "render"
+                              : name == "scene.toml" || name == "diagnostics.csv" || name == "manifest.txt" ||
+                                    name.rfind("particles", 0) == 0 || name == io::RunFolder::kLockFile)
+      throw std::invalid_argument(fmt::format("--summary-json {}: the run writes that file in --out {}; choose another name",
+                                              json.string(), out_dir.string()));
+    outputs.push_back({"--summary-json", json});
+    io::ensure_writable_file(json);
+  }
+  io::check_distinct_outputs(outputs, inputs);
+  if (args.render_every > 0) {
+    const fs::path render = out_dir / "render";
+    std::error_code ec;
+    if (fs::exists(render, ec) && !fs::is_directory(render, ec))
+      throw std::invalid_argument(fmt::format("--render-every: {} is not a folder, the pictures cannot go there", render.string()));
+  }
+}
+
 int run(const RunArgs& args) {
   sim::RunOptions options;
   scene::Scene scene;
@@ -61,16 +93,25 @@ int run(const RunArgs& args) {
       throw std::invalid_argument("--resume continues the scene saved in RUN_DIR; give no SCENE or --set");
     options.out_dir = args.resume;
     options.resume = true;
-    scene = scene::load_scene(options.out_dir / "scene.toml");
+    scene = load_scene_file(options.out_dir / "scene.toml");
   } else {
     if (args.scene.empty()) throw std::invalid_argument("give a SCENE file, or --resume RUN_DIR");
-    scene = scene::load_scene(args.scene, args.overrides);
+    scene = load_scene_file(args.scene, args.overrides);
     options.out_dir = args.out.empty() ? std::filesystem::path("out") / std::filesystem::path(args.scene).stem()
                                        : std::filesystem::path(args.out);
   }
+  check_outputs(args, options.out_dir);
   options.threads = args.threads;
   if (args.steps > 0) options.steps = args.steps;
-  if (args.until > 0) options.until = args.until;
+  if (args.until > 0) {
+    // The step count the run must reach, ceil(T/dt), has to be one it can count.
+    const double steps = std::ceil(args.until / scene.dt);
+    if (!std::isfinite(steps) || steps > static_cast<double>(kMaxSteps))
+      throw std::invalid_argument(fmt::format(
+          "--until {}: that is {:.3g} steps of dt = {}, more than the 2^53 steps a run can count; give a smaller T",
+          args.until, args.until / scene.dt, scene.dt));
+    options.until = args.until;
+  }
   if (args.checkpoint_every > 0) options.checkpoint_every = args.checkpoint_every;
   if (args.checkpoint_every_steps > 0) options.checkpoint_every_steps = args.checkpoint_every_steps;
   options.checkpoint_keep = args.checkpoint_keep;
@@ -121,17 +162,17 @@ void add_run_command(CLI::App& app, Commands& commands) {
   auto* run_cmd = app.add_subcommand("run", "Run a scene file and write its frames");
   run_cmd->add_option("scene", args->scene, "Scene file (TOML)");
   run_cmd->add_option("--threads,-t", args->threads, "Threads (default: all cores, or OMP_NUM_THREADS)")
-      ->check(CLI::PositiveNumber);
+      ->check(thread_count());
   run_cmd->add_option("--out,-o", args->out, "Output directory (default: out/<scene name>)");
   auto* steps_opt = run_cmd->add_option("--steps", args->steps, "Number of steps to take, replacing the scene's end time")
-      ->check(CLI::PositiveNumber);
-  run_cmd->add_option("--until", args->until, "Run until this simulated time")->check(CLI::PositiveNumber)->excludes(steps_opt);
+      ->check(whole_number(1, kMaxSteps));
+  run_cmd->add_option("--until", args->until, "Run until this simulated time")->check(positive_finite())->excludes(steps_opt);
   run_cmd->add_option("--checkpoint-every", args->checkpoint_every, "Write a checkpoint every T of simulated time")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_finite());
   run_cmd->add_option("--checkpoint-every-steps", args->checkpoint_every_steps, "Write a checkpoint every N steps")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxSteps));
   run_cmd->add_option("--checkpoint-keep", args->checkpoint_keep, "Checkpoints to keep (default 2)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxSteps));
   run_cmd->add_option("--resume", args->resume, "Continue the run in RUN_DIR from its newest valid checkpoint")
       ->type_name("RUN_DIR");
   run_cmd->add_option("--set", args->overrides, "Override a scene key, e.g. --set box.restitution=0.9")
@@ -140,7 +181,7 @@ void add_run_command(CLI::App& app, Commands& commands) {
   run_cmd->add_option("--on-blowup", args->on_blowup, "When a blow-up check fails: stop (default) or warn and go on")
       ->check(CLI::IsMember({"stop", "warn", "off"}));
   run_cmd->add_option("--render-every", args->render_every, "Draw every K-th frame as a PNG in OUT/render (see swirl render)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole_number(1, kMaxSteps));
   commands.push_back({run_cmd, [args] { return run(*args); }});
 }
 

@@ -4,6 +4,8 @@
 
 #include "cli.hpp"
 #include "swirl/core/simd_dispatch.hpp"
+#include "swirl/io/read_file.hpp"
+#include "swirl/scene/load.hpp"
 
 namespace swirl::cli {
 namespace {
@@ -25,6 +27,10 @@ std::string json_string(const std::string& s) {
 }
 
 }  // namespace
+
+scene::Scene load_scene_file(const std::filesystem::path& file, std::span<const std::string> overrides) {
+  return scene::parse_scene(io::read_regular_file(file, io::kMaxSceneBytes), file.string(), overrides);
+}
 
 std::string summary_text(const sim::RunSummary& s) {
   std::string out;

@@ -1,6 +1,6 @@
 #include "swirl/io/atomic_file.hpp"
 
-#include "detail.hpp"
+#include "swirl/io/read_file.hpp"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -117,6 +117,23 @@ void ensure_writable_directory(const fs::path& dir, std::uintmax_t bytes_needed)
                               dir.string(), space.available, bytes_needed));
 }
 
-std::string read_text_file(const std::filesystem::path& path) { return detail::read_file(path); }
+void ensure_writable_file(const fs::path& path) {
+  if (path.filename().empty() || path.filename() == "." || path.filename() == "..")
+    throw IoError(fmt::format("{}: not a file name", path.string()));
+  std::error_code ec;
+  const auto st = fs::status(path, ec);
+  if (fs::exists(st) && !fs::is_regular_file(st))
+    throw IoError(fmt::format("{}: exists and is not a regular file", path.string()));
+  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  if (!fs::is_directory(dir, ec))
+    throw IoError(fmt::format("{}: cannot be written: the folder {} does not exist", path.string(), dir.string()));
+  TempFile probe(unique_sibling(path, "probe"));
+  if (probe.open() < 0) fail(path, "cannot be written", errno);
+  if (probe.close() != 0) fail(path, "cannot be written (close failed)", errno);
+}
+
+std::string read_text_file(const std::filesystem::path& path, std::uintmax_t max_bytes) {
+  return read_regular_file(path, max_bytes);
+}
 
 }  // namespace swirl::io

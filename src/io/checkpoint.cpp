@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "detail.hpp"
+#include "swirl/io/read_file.hpp"
 #include "swirl/io/atomic_file.hpp"
 
 namespace swirl::io {
@@ -210,11 +211,11 @@ CheckpointHeader parse_checkpoint(std::string_view bytes, std::string_view name,
 template <class Real>
 CheckpointHeader read_checkpoint(const std::filesystem::path& path, ParticleSet<Real>& particles,
                                  CheckpointValues& values) {
-  return parse_checkpoint(detail::read_file(path), path.string(), particles, values);
+  return parse_checkpoint(read_regular_file(path, max_particle_file_bytes()), path.string(), particles, values);
 }
 
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
-  const std::string bytes = detail::read_file(path);
+  const std::string bytes = read_regular_file(path, max_particle_file_bytes());
   try {
     Cursor in(bytes);
     return parse_header(in);

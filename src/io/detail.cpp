@@ -1,14 +1,7 @@
 #include "detail.hpp"
 
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <cerrno>
-
 #include <fmt/format.h>
 
-#include "swirl/io/atomic_file.hpp"
 
 namespace swirl::io::detail {
 namespace {
@@ -56,28 +49,6 @@ std::string xml_unescape(std::string_view raw) {
 }
 
 }  // namespace
-
-std::string read_file(const std::filesystem::path& path) {
-  int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw IoError(fmt::format("{}: cannot open: {}", path.string(), std::generic_category().message(errno)));
-  std::string data;
-  struct stat st {};
-  if (::fstat(fd, &st) == 0 && S_ISREG(st.st_mode)) data.reserve(static_cast<std::size_t>(st.st_size));
-  char buf[1 << 16];
-  for (;;) {
-    ssize_t n = ::read(fd, buf, sizeof buf);
-    if (n == 0) break;
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      int err = errno;
-      ::close(fd);
-      throw IoError(fmt::format("{}: read failed: {}", path.string(), std::generic_category().message(err)));
-    }
-    data.append(buf, static_cast<std::size_t>(n));
-  }
-  ::close(fd);
-  return data;
-}
 
 std::string xml_escape(std::string_view text) {
   std::string out;

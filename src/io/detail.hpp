@@ -1,4 +1,4 @@
-// Internal helpers of the io module: reading a whole file, a minimal XML tag
+// Internal helpers of the io module: a minimal XML tag
 // scanner for the files this module writes, and strict number parsing.
 #pragma once
 
@@ -19,9 +19,6 @@ namespace swirl::io::detail {
 struct Malformed : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-
-// The whole file; IoError if it cannot be read.
-std::string read_file(const std::filesystem::path& path);
 
 // Escapes text for use inside a double-quoted XML attribute.
 std::string xml_escape(std::string_view text);

@@ -4,6 +4,7 @@
 
 #include "detail.hpp"
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/read_file.hpp"
 
 namespace swirl::io {
 
@@ -30,7 +31,7 @@ void PvdSeries::add(double time, const std::string& relative_file) {
 }
 
 std::vector<PvdEntry> read_pvd(const fs::path& path) {
-  const std::string text = detail::read_file(path);
+  const std::string text = read_regular_file(path, kMaxSeriesBytes);
   try {
     std::vector<PvdEntry> entries;
     detail::XmlScanner scan(text);

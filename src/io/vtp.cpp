@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "detail.hpp"
+#include "swirl/io/read_file.hpp"
 #include "swirl/io/atomic_file.hpp"
 
 namespace swirl::io {
@@ -360,7 +361,7 @@ template void write_vtp<float>(const fs::path&, const ParticleSet<float>&, doubl
 template void write_vtp<double>(const fs::path&, const ParticleSet<double>&, double);
 
 VtpFile read_vtp(const fs::path& path) {
-  const std::string text = detail::read_file(path);
+  const std::string text = read_regular_file(path, max_particle_file_bytes());
   try {
     return parse_vtp(text);
   } catch (const Malformed& e) {

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/read_file.hpp"
 
 namespace swirl::render {
 namespace {
@@ -37,6 +38,7 @@ char32_t next_code_point(std::string_view text, std::size_t& i) {
 std::filesystem::path default_font_path() { return "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf"; }
 
 struct Font::Impl {
+  std::string bytes;  // the font file; FreeType reads from it for the face's lifetime
   FT_Library library = nullptr;
   FT_Face face = nullptr;
   ~Impl() {
@@ -50,10 +52,13 @@ struct Font::Impl {
 
 Font::Font(const std::filesystem::path& file) : impl_(std::make_unique<Impl>()) {
   const std::string hint = file == default_font_path() ? " (install Debian's fonts-dejavu-core: make deps)" : "";
-  if (!std::filesystem::is_regular_file(file))
-    throw io::IoError(file.string() + ": font file not found" + hint);
+  if (!std::filesystem::exists(file)) throw io::IoError(file.string() + ": font file not found" + hint);
+  // Read by io's one reader (a regular file of font size, never a FIFO),
+  // then handed to FreeType from memory.
+  impl_->bytes = io::read_regular_file(file, io::kMaxFontBytes);
   if (FT_Init_FreeType(&impl_->library) != 0) throw io::IoError("FreeType could not be initialised");
-  if (FT_New_Face(impl_->library, file.c_str(), 0, &impl_->face) != 0)
+  if (FT_New_Memory_Face(impl_->library, reinterpret_cast<const FT_Byte*>(impl_->bytes.data()),
+                         static_cast<FT_Long>(impl_->bytes.size()), 0, &impl_->face) != 0)
     throw io::IoError(file.string() + ": not a font FreeType can read" + hint);
 }
 

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/read_file.hpp"
 #include "swirl/render/png.hpp"
 #include "swirl/render/splats.hpp"
 #include "swirl/render/surface_density.hpp"
@@ -137,7 +138,8 @@ RunInfo read_run(const std::filesystem::path& dir) {
                       dir.string());
   const fs::path scene_file = dir / "scene.toml";
   if (fs::exists(scene_file)) {
-    const scene::Scene s = scene::load_scene(scene_file);
+    // parse_scene on io's checked read: the scene loader's own read would block on a FIFO.
+    const scene::Scene s = scene::parse_scene(io::read_regular_file(scene_file, io::kMaxSceneBytes), scene_file.string());
     run.has_scene = true;
     run.nbody = s.nbody.has_value();
     if (s.walls && !run.nbody) run.box = s.box;

@@ -1,6 +1,10 @@
 #include "swirl/render/font.hpp"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
 
 #include "swirl/io/atomic_file.hpp"
 
@@ -44,6 +48,19 @@ TEST(Font, AMissingFontFileIsNamed) {
   } catch (const io::IoError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/Font.ttf"), std::string::npos) << e.what();
   }
+}
+
+// A FIFO as the font is refused at once (FreeType would block reading it).
+TEST(Font, AFifoIsRefusedNotWaitedOn) {
+  const auto fifo = std::filesystem::temp_directory_path() / ("swirl-font-fifo-" + std::to_string(::getpid()));
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  try {
+    Font font(fifo);
+    ADD_FAILURE() << "loaded a FIFO as a font";
+  } catch (const io::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a FIFO"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(fifo);
 }
 
 }  // namespace

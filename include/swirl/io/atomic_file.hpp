@@ -23,12 +23,19 @@ class IoError : public std::runtime_error {
 // thrown.
 void write_file_atomic(const std::filesystem::path& path, std::string_view bytes, bool sync = false);
 
-// The whole content of a file; IoError naming the file if it cannot be read.
-std::string read_text_file(const std::filesystem::path& path);
+// The whole content of a file (io::read_regular_file: a regular file of at
+// most max_bytes, 1 GiB by default); IoError naming the file otherwise.
+std::string read_text_file(const std::filesystem::path& path, std::uintmax_t max_bytes = std::uintmax_t{1} << 30);
 
 // Throws IoError unless `dir` exists (it is created if missing), a file can be
 // created in it, and its file system has at least `bytes_needed` bytes free
 // (the message then gives both figures).
 void ensure_writable_directory(const std::filesystem::path& dir, std::uintmax_t bytes_needed = 0);
+
+// Throws IoError unless write_file_atomic(path, ...) could succeed now: `path`
+// is not a directory or other non-regular file, and its directory exists (it
+// is not created) and a file can be created in it. Checks an output before the
+// work that produces it.
+void ensure_writable_file(const std::filesystem::path& path);
 
 }  // namespace swirl::io

@@ -45,10 +45,32 @@ namespace swirl::parallel {
 // Threads the next parallel loop will use.
 inline int thread_count() { return omp_get_max_threads(); }
 
-// Sets the threads used by later loops; n ≥ 1.
+// The most threads swirl starts. OpenMP starts every thread it is asked for,
+// and tens of thousands exhaust the memory for their stacks: the runtime then
+// crashes (SIGSEGV) instead of reporting an error. More than 4 threads per
+// hardware thread never speed a pass up; 64 at least still lets a small
+// machine test that results do not depend on the thread count.
+inline int max_thread_count() { return std::clamp(4 * omp_get_num_procs(), 64, 1024); }
+
+// Sets the threads used by later loops; 1 <= n <= max_thread_count(), else
+// std::invalid_argument.
 inline void set_thread_count(int n) {
   if (n < 1) throw std::invalid_argument("thread count must be at least 1");
+  if (n > max_thread_count())
+    throw std::invalid_argument("thread count " + std::to_string(n) + " is more than the " +
+                                std::to_string(max_thread_count()) + " threads swirl starts on this machine");
   omp_set_num_threads(n);
+}
+
+// OMP_NUM_THREADS (or anything else that set OpenMP's default) above
+// max_thread_count() is lowered to it, for the same reason; returns a warning
+// to show the user then, or an empty string.
+inline std::string clamp_default_thread_count() {
+  const int asked = omp_get_max_threads(), max = max_thread_count();
+  if (asked <= max) return {};
+  omp_set_num_threads(max);
+  return "OpenMP was asked for " + std::to_string(asked) + " threads (OMP_NUM_THREADS); using " +
+         std::to_string(max) + ", the most swirl starts on this machine";
 }
 
 // Number of blocks of block_size items covering n items.
