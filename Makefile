@@ -61,7 +61,7 @@ unit-test: build
 demo: deps-build
 	cmake --preset demo
 	cmake --build --preset demo -j $(JOBS) --target swirl_cli
-	./build-demo/swirl run $(DEMO) --out $(DEMO_OUT)
+	./build-demo/swirl run $(DEMO) --out $(DEMO_OUT) --overwrite
 	@echo "Open $(DEMO_OUT)/particles.pvd in ParaView."
 
 # The seeds' experiments at their default sizes (each suite's CSV, JSON,

@@ -43,6 +43,7 @@ struct RunArgs {
   std::uint64_t checkpoint_every_steps = 0;
   std::size_t checkpoint_keep = 2;
   std::string resume;
+  bool overwrite = false;
   std::uint64_t render_every = 0;  // draw every K-th frame while running (0: off)
 };
 
@@ -91,6 +92,7 @@ int run(const RunArgs& args) {
   if (!args.resume.empty()) {
     if (!args.scene.empty() || !args.overrides.empty())
       throw std::invalid_argument("--resume continues the scene saved in RUN_DIR; give no SCENE or --set");
+    if (args.overwrite) throw std::invalid_argument("--overwrite starts a new run; it cannot go with --resume");
     options.out_dir = args.resume;
     options.resume = true;
     scene = load_scene_file(options.out_dir / "scene.toml");
@@ -115,6 +117,7 @@ int run(const RunArgs& args) {
   if (args.checkpoint_every > 0) options.checkpoint_every = args.checkpoint_every;
   if (args.checkpoint_every_steps > 0) options.checkpoint_every_steps = args.checkpoint_every_steps;
   options.checkpoint_keep = args.checkpoint_keep;
+  options.overwrite = args.overwrite;
   options.on_blow_up = args.on_blowup == "warn" ? OnBlowUp::Warn : args.on_blowup == "off" ? OnBlowUp::Off : OnBlowUp::Stop;
   options.on_warning = [](const std::string& w) {
     fmt::print(stderr, "{}swirl run: warning: {}\n", ::isatty(STDERR_FILENO) ? "\n" : "", w);
@@ -175,6 +178,8 @@ void add_run_command(CLI::App& app, Commands& commands) {
       ->check(whole_number(1, kMaxSteps));
   run_cmd->add_option("--resume", args->resume, "Continue the run in RUN_DIR from its newest valid checkpoint")
       ->type_name("RUN_DIR");
+  run_cmd->add_flag("--overwrite", args->overwrite,
+                    "Replace the run in --out: delete the files its manifest lists (nothing else) first");
   run_cmd->add_option("--set", args->overrides, "Override a scene key, e.g. --set box.restitution=0.9")
       ->type_name("KEY=VALUE");
   run_cmd->add_option("--summary-json", args->summary_json, "Also write the closing summary as JSON to FILE");

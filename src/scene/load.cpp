@@ -20,6 +20,7 @@
 
 #include "messages.hpp"
 #include "sources.hpp"
+#include "swirl/io/read_file.hpp"
 #include "swirl/scene/keys.hpp"
 #include "swirl/scene/validate.hpp"
 #include "swirl/sph/lattice_mass.hpp"
@@ -596,15 +597,14 @@ void apply_override(toml::table& root, std::string_view text, const Reader& r) {
   }
 }
 
-std::string read_file(const std::filesystem::path& file, const std::string& name) {
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(file.c_str(), "rb"), &std::fclose);
-  if (!f) raise(fmt::format("{}: cannot read: {}", name, std::strerror(errno)));
-  std::string text;
-  char buffer[1 << 16];
-  std::size_t n = 0;
-  while ((n = std::fread(buffer, 1, sizeof buffer, f.get())) > 0) text.append(buffer, n);
-  if (std::ferror(f.get())) raise(fmt::format("{}: cannot read: {}", name, std::strerror(errno)));
-  return text;
+// Through the one guarded reader (io/read_file.hpp): a FIFO or a device is
+// refused instead of blocking, and at most kMaxSceneBytes are read.
+std::string read_file(const std::filesystem::path& file, const std::string& /*name*/) {
+  try {
+    return io::read_regular_file(file, io::kMaxSceneBytes);
+  } catch (const io::IoError& e) {
+    raise(e.what());
+  }
 }
 
 

@@ -15,6 +15,7 @@
 #include "swirl/io/checkpoint.hpp"
 #include "swirl/io/csv.hpp"
 #include "swirl/io/pvd.hpp"
+#include "swirl/io/run_folder.hpp"
 #include "swirl/io/vtp.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
@@ -30,9 +31,9 @@ namespace {
 template <class Real>
 class FrameWriter final : public Observer<Real> {
  public:
-  FrameWriter(const scene::Scene& scene, const RunOptions& options)
+  FrameWriter(const scene::Scene& scene, const RunOptions& options, io::RunFolder& folder)
       : formats_(scene.formats), dir_(options.out_dir), series_(dir_ / "particles.pvd"),
-        schedule_(scene.output_interval, scene.dt), on_frame_(options.on_frame) {}
+        schedule_(scene.output_interval, scene.dt), on_frame_(options.on_frame), folder_(folder) {}
 
   std::string_view name() const override { return "frames"; }
   void on_start(Simulation<Real>& sim, bool resumed) override {
@@ -75,11 +76,12 @@ class FrameWriter final : public Observer<Real> {
       std::filesystem::path file;
       if (format == scene::OutputFormat::Vtp) {
         const std::string name = fmt::format("particles_{:06d}.vtp", frames_);
-        file = dir_ / name;
+        file = folder_.claim(dir_ / name);
         io::write_vtp(file, sim.particles(), sim.time());
+        folder_.claim(dir_ / "particles.pvd");
         series_.add(sim.time(), name);
       } else {
-        file = dir_ / fmt::format("particles_{:06d}.csv", frames_);
+        file = folder_.claim(dir_ / fmt::format("particles_{:06d}.csv", frames_));
         io::write_csv(file, sim.particles(), sim.time());
       }
       if (first.empty()) first = file;
@@ -94,6 +96,7 @@ class FrameWriter final : public Observer<Real> {
   io::PvdSeries series_;
   IntervalSchedule schedule_;
   std::function<void(const std::filesystem::path&, double)> on_frame_;
+  io::RunFolder& folder_;
   std::size_t frames_ = 0;
   std::uint64_t last_step_ = 0;
 };
@@ -109,9 +112,10 @@ class FrameWriter final : public Observer<Real> {
 template <class Real>
 class DiagnosticsLog final : public Observer<Real> {
  public:
-  DiagnosticsLog(const scene::Scene& scene, const RunOptions& options, const Simulation<Real>& sim)
+  DiagnosticsLog(const scene::Scene& scene, const RunOptions& options, const Simulation<Real>& sim,
+                 io::RunFolder& folder)
       : path_(options.out_dir / "diagnostics.csv"), schedule_(scene.output_interval, scene.dt),
-        adaptive_(scene.adaptive_dt), dt_max_(scene.dt), block_size_(scene.block_size) {
+        adaptive_(scene.adaptive_dt), dt_max_(scene.dt), block_size_(scene.block_size), folder_(folder) {
     conservative_ = std::all_of(sim.solvers().begin(), sim.solvers().end(),
                                 [](const auto& s) { return s->conserves_energy(); });
     std::string header = "time,kinetic_energy,potential_energy,total_energy";
@@ -192,7 +196,7 @@ class DiagnosticsLog final : public Observer<Real> {
       frame_dt_min_ = std::numeric_limits<double>::infinity(), frame_dt_max_ = 0;
     }
     text_ += "\n";
-    io::write_file_atomic(path_, text_);
+    io::write_file_atomic(folder_.claim(path_), text_);
     ++rows_;
     last_step_ = sim.step_count();
   }
@@ -238,6 +242,7 @@ class DiagnosticsLog final : public Observer<Real> {
   bool adaptive_;
   double dt_max_;
   std::size_t block_size_;
+  io::RunFolder& folder_;
   bool conservative_ = true;
   std::string text_;
   std::size_t rows_ = 0;
@@ -253,12 +258,14 @@ class DiagnosticsLog final : public Observer<Real> {
 // fields, the simulation's clock and state, and every observer's state.
 std::filesystem::path checkpoint_dir(const std::filesystem::path& out) { return out / "checkpoints"; }
 
-// Checkpoint files, newest (highest step) first.
-std::vector<std::filesystem::path> checkpoints_in(const std::filesystem::path& out) {
+// This run's checkpoint files (the run folder's manifest lists them; a user's
+// or another run's .swc is never chosen or pruned), newest (highest step) first.
+std::vector<std::filesystem::path> checkpoints_in(const io::RunFolder& folder) {
   std::vector<std::filesystem::path> files;
-  if (!std::filesystem::is_directory(checkpoint_dir(out))) return files;
-  for (const auto& e : std::filesystem::directory_iterator(checkpoint_dir(out)))
-    if (e.path().extension() == ".swc") files.push_back(e.path());
+  const auto dir = checkpoint_dir(folder.dir());
+  if (!std::filesystem::is_directory(dir)) return files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".swc" && folder.owns(e.path())) files.push_back(e.path());
   std::sort(files.rbegin(), files.rend());
   return files;
 }
@@ -271,9 +278,10 @@ template <class Real>
 class Checkpointer final : public Observer<Real> {
  public:
   using Collect = std::function<void(NamedValues&)>;
-  Checkpointer(const scene::Scene& scene, const RunOptions& options, std::uint64_t scene_hash, Collect collect)
+  Checkpointer(const scene::Scene& scene, const RunOptions& options, std::uint64_t scene_hash, Collect collect,
+               io::RunFolder& folder)
       : options_(options), schedule_(options.checkpoint_every.value_or(0), scene.dt), hash_(scene_hash),
-        collect_(std::move(collect)) {}
+        collect_(std::move(collect)), folder_(folder) {}
 
   std::string_view name() const override { return "checkpoints"; }
   void on_step(Simulation<Real>& sim) override {
@@ -298,14 +306,16 @@ class Checkpointer final : public Observer<Real> {
     ScopedPhase phase(sim.timers(), "output");
     NamedValues values;
     collect_(values);
-    std::filesystem::create_directories(checkpoint_dir(options_.out_dir));
-    const auto file = checkpoint_dir(options_.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count());
+    // Claimed (and the manifest synced) before it is written: a resume after a
+    // power cut still knows it is this run's.
+    const auto file = folder_.claim(
+        checkpoint_dir(options_.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count()), /*sync=*/true);
     io::write_checkpoint(file, sim.particles(),
                          {sizeof(Real), sim.particles().size(), hash_, sim.step_count(), sim.time()}, values);
     last_ = file;
-    const auto files = checkpoints_in(options_.out_dir);
+    const auto files = checkpoints_in(folder_);
     for (std::size_t k = std::max<std::size_t>(options_.checkpoint_keep, 1); k < files.size(); ++k)
-      std::filesystem::remove(files[k]);
+      folder_.remove(files[k]);
   }
   const std::filesystem::path& last() const { return last_; }
 
@@ -314,6 +324,7 @@ class Checkpointer final : public Observer<Real> {
   IntervalSchedule schedule_;
   std::uint64_t hash_;
   Collect collect_;
+  io::RunFolder& folder_;
   std::filesystem::path last_;
   std::uint64_t last_step_ = 0;
 };
@@ -398,9 +409,9 @@ std::uint64_t steps_until(double t, double dt) {
 // Reads the newest valid checkpoint of this scene into sim and returns its
 // header and values; warnings name the files skipped.
 template <class Real>
-std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<Real>& sim, const RunOptions& options,
+std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<Real>& sim, const io::RunFolder& folder,
                                                                     std::uint64_t hash, RunSummary& summary) {
-  for (const auto& file : checkpoints_in(options.out_dir)) {
+  for (const auto& file : checkpoints_in(folder)) {
     try {
       NamedValues values;
       const auto h = io::read_checkpoint(file, sim.particles(), values);
@@ -413,7 +424,7 @@ std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<R
       summary.warnings.push_back(fmt::format("skipping checkpoint: {}", e.what()));
     }
   }
-  throw io::IoError(fmt::format("{}: no valid checkpoint to resume from{}", checkpoint_dir(options.out_dir).string(),
+  throw io::IoError(fmt::format("{}: no valid checkpoint to resume from{}", checkpoint_dir(folder.dir()).string(),
                                 summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
 }
 
@@ -431,6 +442,13 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   // Only now, so that a scene refused while its particles are built leaves no
   // empty output directory behind; nothing has been run yet.
   io::ensure_writable_directory(options.out_dir, first_output_bytes);
+  // The folder is this run's for as long as it runs (a lock), and it writes
+  // only files that are its own (io/run_folder.hpp).
+  io::RunFolder folder(options.out_dir,
+                       options.resume      ? io::RunFolderMode::Resume
+                       : options.overwrite ? io::RunFolderMode::Overwrite
+                                           : io::RunFolderMode::Fresh,
+                       fmt::format("{} {:016x}", scene.file, hash));
   sim.set_on_blow_up(options.on_blow_up);
   sim.prepare();  // every field declared, so a checkpoint's fields meet their uses
   summary.particles = sim.particles().size();
@@ -448,8 +466,8 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   };
 
   // The observers, in the order they act after a step.
-  auto frames = std::make_unique<FrameWriter<Real>>(scene, options);
-  auto diagnostics = std::make_unique<DiagnosticsLog<Real>>(scene, options, sim);
+  auto frames = std::make_unique<FrameWriter<Real>>(scene, options, folder);
+  auto diagnostics = std::make_unique<DiagnosticsLog<Real>>(scene, options, sim, folder);
   auto guard = std::make_unique<GuardReporter<Real>>(options.on_warning);
   auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps);
   std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get(), guard.get()};
@@ -458,19 +476,20 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     sim.save_state(values);
     for (const Observer<Real>* o : observers) o->save_state(values);
   };
-  auto checkpoints = std::make_unique<Checkpointer<Real>>(scene, options, hash, collect);
+  auto checkpoints = std::make_unique<Checkpointer<Real>>(scene, options, hash, collect, folder);
   observers.push_back(checkpoints.get());
   observers.push_back(progress.get());
 
   if (options.resume) {
-    const auto [header, values] = read_newest_checkpoint(sim, options, hash, summary);
+    const auto [header, values] = read_newest_checkpoint(sim, folder, hash, summary);
     SimulationClock clock{header.step, header.time, find_value(values, "clock.previous_dt").value_or(0),
                           find_value(values, "clock.dt_floor").value_or(0)};
     sim.resume(clock, values);
     for (Observer<Real>* o : observers) o->load_state(values);
     summary.first_step = header.step;
   } else {
-    io::write_file_atomic(options.out_dir / "scene.toml", scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
+    io::write_file_atomic(folder.claim(options.out_dir / "scene.toml"),
+                          scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
   }
   if (options.until) target = steps_until(*options.until, scene.dt);
   if (options.steps) target = summary.first_step + *options.steps;

@@ -10,9 +10,11 @@ must be placed in it.
 The ranks are the layering that holds today (lowest first). docs name the
 coarse layers core; parallel; spatial, io; force, integrate, boundary, sph,
 gravity; scene; sim; render; CLI. Within the solver layer the includes are
-finer: sph and gravity use force (the ForceModel interface) and gravity uses
-integrate (its leapfrog), so force, integrate and boundary rank below sph and
-gravity. render reads scenes (the run's Scene) and io (frames) but not sim.
+finer: the steppers (integrate) apply the box (boundary) and return the
+step's scan (force/step_scan.hpp); sph and gravity implement the Solver seam
+(force) and gravity's benchmark steps with a stepper (integrate). So
+boundary < force < integrate < sph, gravity. render reads scenes (the run's
+Scene) and io (frames) but not sim.
 
 Usage: check_layering.py SOURCE_DIR
 """
@@ -24,12 +26,14 @@ RANK = {
     "core": 0,
     "parallel": 1,
     "spatial": 2, "io": 2,
-    "force": 3, "integrate": 3, "boundary": 3,
-    "sph": 4, "gravity": 4,
-    "scene": 5,
-    "sim": 6,
-    "render": 7,
-    "apps": 8,  # apps/swirl: the CLI, above everything
+    "boundary": 3,
+    "force": 4,
+    "integrate": 5,
+    "sph": 6, "gravity": 6,
+    "scene": 7,
+    "sim": 8,
+    "render": 9,
+    "apps": 10,  # apps/swirl: the CLI, above everything
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]swirl/([A-Za-z0-9_]+)/', re.MULTILINE)

@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <string>
 
+#include "swirl/io/atomic_file.hpp"  // IoError
+
 namespace swirl::io {
 
 // Upper bounds of the files swirl reads. Text files are bounded by what swirl

@@ -50,6 +50,10 @@ struct RunOptions {
   // Continue the run in out_dir from its newest valid checkpoint (the scene
   // must be the one saved there, out_dir/scene.toml).
   bool resume = false;
+  // A new run into a folder that holds another run: delete that run's files
+  // (those its manifest lists, nothing else) first. Without it such a folder
+  // is refused (io/run_folder.hpp).
+  bool overwrite = false;
 
   // When set (by a signal handler), the run stops after the current step,
   // writes a checkpoint and returns with RunSummary::interrupted.
