@@ -49,7 +49,7 @@ struct Box {
   ParticleSet<Real> p;
   sph::SphParameters params;
   sph::SphFluid<Real> fluid;
-  sph::GridPassConstants<Real> k;
+  sph::SphLaws<Real> k;
 
   static sph::SphParameters parameters() {
     sph::SphParameters s;
@@ -62,7 +62,7 @@ struct Box {
     return s;
   }
 
-  Box() : p(kParticles), params(parameters()), fluid(params) {
+  Box() : p(kParticles), params(parameters()), fluid(params), k(params) {
     SplitMix64 rng(8);
     for (std::size_t i = 0; i < p.size(); ++i) {
       for (int a = 0; a < 3; ++a) {
@@ -74,12 +74,6 @@ struct Box {
     }
     fluid.add_acceleration(p, ForceContext{0, kBlock, nullptr});  // sorts p into cell order, builds the grid
     if (!fluid.used_grid()) throw std::runtime_error("test set-up: the grid was not used");
-    k.h = Real(params.smoothing_length);
-    k.h2 = k.h * k.h;
-    k.rest_density = Real(params.rest_density);
-    k.c2 = Real(params.sound_speed * params.sound_speed);
-    k.pressure_floor = -std::numeric_limits<Real>::infinity();
-    k.mu = Real(params.viscosity);
   }
 };
 
