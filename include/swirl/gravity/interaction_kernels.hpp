@@ -3,7 +3,7 @@
 // particle of a group, over structure-of-arrays data.
 //
 // Laws (G = 1, Plummer softening ε, eps2 = ε²; d = source − target):
-//   particle  the pair law of pair_law.hpp: a += m d / (|d|² + ε²)^{3/2},
+//   particle  the pair law of pair_law.hpp (add_point): a += m d / (|d|² + ε²)^{3/2},
 //             φ −= m / sqrt(|d|² + ε²); a pair at zero softened distance
 //             contributes nothing;
 //   monopole  the same law with the cell's mass at its centre of mass;
@@ -11,7 +11,7 @@
 //             Q_ij = Σ m (3 r_i r_j − r² δ_ij) about the centre of mass
 //             (qzz = −qxx − qyy), r = target − centre of mass:
 //             φ −= ½ rᵀQr / R⁵, a = −∇φ, R = sqrt(|r|² + ε²)
-//             (the formulas of LinearOctree::walk_one).
+//             (pair_law.hpp's add_cell, which LinearOctree::walk_one calls too).
 // The field is ADDED to the targets' ax, ay, az, phi.
 //
 // Two paths of the same formulas:
