@@ -41,25 +41,35 @@ void particle_field_scalar(const SourceParticles<Real>& s, const Targets<Real>& 
   }
 }
 
-template <class Real>
-void cell_field_scalar(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, bool quadrupole) {
+// law(j, dx, dy, dz, inv, acc) adds cell j's term to acc.
+template <class Real, class Law>
+void cells_scalar(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, Law&& law) {
   for (std::size_t i = 0; i < t.n; ++i) {
     const Real tx = t.x[i], ty = t.y[i], tz = t.z[i];
     Accumulator<Real> acc;
     for (std::size_t j = 0; j < s.n; ++j) {
       const Real dx = s.x[j] - tx, dy = s.y[j] - ty, dz = s.z[j] - tz;
-      const Real inv = inverse_distance(dx * dx + dy * dy + dz * dz + eps2);
-      if (quadrupole) {
-        const Quadrupole<Real> Q{s.qxx[j], s.qxy[j], s.qxz[j], s.qyy[j], s.qyz[j], -(s.qxx[j] + s.qyy[j])};
-        add_cell(dx, dy, dz, s.m[j], Q, inv, acc);
-      } else {
-        add_point(dx, dy, dz, s.m[j], inv, acc);
-      }
+      law(j, dx, dy, dz, inverse_distance(dx * dx + dy * dy + dz * dz + eps2), acc);
     }
     t.ax[i] += acc.ax;
     t.ay[i] += acc.ay;
     t.az[i] += acc.az;
     t.phi[i] += acc.phi;
+  }
+}
+
+template <class Real>
+void cell_field_scalar(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, bool quadrupole) {
+  // The law is chosen once per call, not per interaction.
+  if (quadrupole) {
+    cells_scalar(s, t, eps2, [&](std::size_t j, Real dx, Real dy, Real dz, Real inv, Accumulator<Real>& acc) {
+      const Quadrupole<Real> Q{s.qxx[j], s.qxy[j], s.qxz[j], s.qyy[j], s.qyz[j], -(s.qxx[j] + s.qyy[j])};
+      add_cell(dx, dy, dz, s.m[j], Q, inv, acc);
+    });
+  } else {
+    cells_scalar(s, t, eps2, [&](std::size_t j, Real dx, Real dy, Real dz, Real inv, Accumulator<Real>& acc) {
+      add_point(dx, dy, dz, s.m[j], inv, acc);
+    });
   }
 }
 

@@ -131,11 +131,11 @@ void forces_cell(const ForceKernelArgs<Real>& a, std::size_t first, std::size_t 
         const auto in = (r2 < hh) & (iota < B(live_lanes<Real>(end - j)));
         const auto apart = r2 > zero;
         const B inv_r = inverse_sqrt(xsimd::select(apart, r2, one));
-        const B rr = r2 * inv_r;
+        const B q = laws.gap(r2 * inv_r);
         const B Vj = B::load_unaligned(V + j);
         // Lanes out of range, and r = 0 for the pressure (no direction), masked after the laws.
-        const B fp = xsimd::select(apart & in, laws.pressure.term(pri, Vj, B::load_unaligned(PV + j), rr, inv_r), zero);
-        const B fv = xsimd::select(in, laws.viscosity.term(Vj, rr), zero);
+        const B fp = xsimd::select(apart & in, laws.pressure.term(pri, Vj, B::load_unaligned(PV + j), q, inv_r), zero);
+        const B fv = xsimd::select(in, laws.viscosity.term(Vj, q), zero);
         spx += fp * dx;
         spy += fp * dy;
         spz += fp * dz;
@@ -148,8 +148,9 @@ void forces_cell(const ForceKernelArgs<Real>& a, std::size_t first, std::size_t 
         const Real r2 = dx * dx + dy * dy + dz * dz;
         if (!(r2 < h2)) continue;
         const Real rr = std::sqrt(r2), inv_r = rr > Real(0) ? Real(1) / rr : Real(0);  // 1/r = 0: no pressure at r = 0
-        const Real fp = laws.pressure.term(pr[i], V[j], PV[j], rr, inv_r);
-        const Real fv = laws.viscosity.term(V[j], rr);
+        const Real q = laws.gap(rr);
+        const Real fp = laws.pressure.term(pr[i], V[j], PV[j], q, inv_r);
+        const Real fv = laws.viscosity.term(V[j], q);
         px += fp * dx;
         py += fp * dy;
         pz += fp * dz;

@@ -83,7 +83,7 @@ TYPED_TEST(LawTest, PressureTermIsEquation2_8) {
     const SphLaws<Real> laws(parameters(h, form));
     const double half = form == PressureForm::Thesis ? 0.5 : 1.0;
     const double vol_j = m_j / rho_j;
-    const Real term = laws.pressure.term(Real(p_i), Real(vol_j), Real(p_j * vol_j), Real(r), Real(1 / r));
+    const Real term = laws.pressure.term(Real(p_i), Real(vol_j), Real(p_j * vol_j), laws.gap(Real(r)), Real(1 / r));
     for (int a = 0; a < 3; ++a) {
       const double grad = -45 / (kPi * std::pow(h, 6)) * (h - r) * (h - r) * rv[a] / r;
       const double expected = -m_j * (p_i + p_j) * half / rho_j * grad;
@@ -101,10 +101,12 @@ TYPED_TEST(LawTest, ViscosityTermIsEquation2_10) {
   const double h = 0.1, mu = 0.25, m_j = 0.5, rho_j = 990, r = 0.037, dv = -0.8;
   const SphLaws<Real> laws(parameters(h));
   const double expected = mu * m_j * dv / rho_j * 45 / (kPi * std::pow(h, 6)) * (h - r);
-  const double got = double(laws.viscosity.norm) * double(laws.viscosity.term(Real(m_j / rho_j), Real(r))) * dv;
+  const double got = double(laws.viscosity.norm) * double(laws.viscosity.term(Real(m_j / rho_j), laws.gap(Real(r)))) * dv;
   EXPECT_NEAR(got, expected, 8 * rel_tol<Real>() * std::abs(expected));
   // Finite at r = 0 (unlike the pressure term, which the caller takes out there).
-  EXPECT_EQ(laws.viscosity.term(Real(2), Real(0)), Real(2) * Real(h));
+  EXPECT_EQ(laws.viscosity.term(Real(2), laws.gap(Real(0))), Real(2) * Real(h));
+  // The gap h − r is clamped at 0 just outside h (r from r² · (1/r) may round past h).
+  EXPECT_EQ(laws.gap(Real(h) * Real(1.0001)), Real(0));
 }
 
 TYPED_TEST(LawTest, AccelerationDividesTheNormalisedSumsByDensity) {
@@ -133,12 +135,12 @@ TYPED_TEST(LawTest, BatchesEvaluateTheSameLaws) {
   const B rb = B::load_aligned(r), mb = B::load_aligned(m), pb = B::load_aligned(p), vb = B::load_aligned(vol);
   alignas(64) Real density[W], pressure[W], viscosity[W];
   laws.density.term(mb, rb * rb).store_aligned(density);
-  laws.pressure.term(B(Real(7)), vb, pb * vb, rb, B(Real(1)) / rb).store_aligned(pressure);
-  laws.viscosity.term(vb, rb).store_aligned(viscosity);
+  laws.pressure.term(B(Real(7)), vb, pb * vb, laws.gap(rb), B(Real(1)) / rb).store_aligned(pressure);
+  laws.viscosity.term(vb, laws.gap(rb)).store_aligned(viscosity);
   for (std::size_t k = 0; k < W; ++k) {
     const Real d = laws.density.term(m[k], r[k] * r[k]);
-    const Real f = laws.pressure.term(Real(7), vol[k], p[k] * vol[k], r[k], Real(1) / r[k]);
-    const Real v = laws.viscosity.term(vol[k], r[k]);
+    const Real f = laws.pressure.term(Real(7), vol[k], p[k] * vol[k], laws.gap(r[k]), Real(1) / r[k]);
+    const Real v = laws.viscosity.term(vol[k], laws.gap(r[k]));
     EXPECT_NEAR(double(density[k]), double(d), 8 * rel_tol<Real>() * std::abs(double(d))) << k;
     EXPECT_NEAR(double(pressure[k]), double(f), 8 * rel_tol<Real>() * std::abs(double(f))) << k;
     EXPECT_NEAR(double(viscosity[k]), double(v), 8 * rel_tol<Real>() * std::abs(double(v))) << k;

@@ -207,9 +207,9 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     const Real r2 = dx * dx + dy * dy + dz * dz;
     if (!spatial::within(r2, h2)) return;
     // 1/r = 0 at r = 0 takes the pair (i itself, or a coincident j) out of the pressure sum.
-    const Real r = std::sqrt(r2), inv_r = r > Real(0) ? Real(1) / r : Real(0);
-    const Real fp = laws.pressure.term(pr[i], V[j], PV[j], r, inv_r);
-    const Real fv = laws.viscosity.term(V[j], r);
+    const Real r = std::sqrt(r2), inv_r = r > Real(0) ? Real(1) / r : Real(0), q = laws.gap(r);
+    const Real fp = laws.pressure.term(pr[i], V[j], PV[j], q, inv_r);
+    const Real fv = laws.viscosity.term(V[j], q);
     s.px += fp * dx;
     s.py += fp * dy;
     s.pz += fp * dz;

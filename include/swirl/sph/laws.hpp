@@ -97,19 +97,17 @@ struct DensityLaw {
 //       = norm · Σ_j (p_i V_j + p_j V_j) (h − r)² / r · r⃗_ij,   r⃗_ij = x_i − x_j
 //   norm = 45 / (π h⁶) · ½   (the ½ of the thesis's form; 1 with PressureForm::Consistent)
 // norm > 0: a positive pressure pushes i away from j. term() is one j's
-// (p_i V_j + p_j V_j) (h − r)²/r, the factor of r⃗_ij; the caller gives r and
-// 1/r (from the same r², as exactly as it computes them) and takes r = 0 out
-// (the direction is undefined there: the pair contributes nothing).
-// p_j V_j comes precomputed per particle (the density pass leaves it).
+// (p_i V_j + p_j V_j) (h − r)²/r, the factor of r⃗_ij, from q = h − r
+// (SphLaws::gap(r)) and 1/r, which the caller computes from the same r², as
+// exactly as it can; the caller takes r = 0 out (e.g. 1/r = 0 there: the
+// direction is undefined and the pair contributes nothing). p_j V_j comes
+// precomputed per particle (the density pass leaves it).
 template <class Real>
 struct PressureLaw {
-  Real h = 1;     // m
   Real norm = 0;  // 1/m⁶
 
   template <class V>
-  SWIRL_LAW_INLINE V term(const V& p_i, const V& vol_j, const V& pvol_j, const V& r, const V& inv_r) const {
-    // max(·, 0): r computed as r² · (1/r) may exceed h by a rounding for r² < h².
-    const V q = law_detail::max_of(V(h) - r, V(Real(0)));
+  SWIRL_LAW_INLINE V term(const V& p_i, const V& vol_j, const V& pvol_j, const V& q, const V& inv_r) const {
     return (p_i * vol_j + pvol_j) * (q * q * inv_r);
   }
 };
@@ -117,15 +115,14 @@ struct PressureLaw {
 // Viscosity force (eq. 2.10) with ∇²W_viscosity (eq. 2.15) and V_j = m_j / ρ_j:
 //   f_i = μ Σ_j m_j (v_j − v_i) / ρ_j ∇²W_visc(r_ij)
 //       = norm · Σ_j V_j (h − r) (v_j − v_i),   norm = μ · 45 / (π h⁶)
-// term() is one j's V_j (h − r), the factor of (v_j − v_i); it is finite at r = 0.
+// term() is one j's V_j (h − r), the factor of (v_j − v_i), from q = h − r
+// (SphLaws::gap(r)); it is finite at r = 0.
 template <class Real>
 struct ViscosityLaw {
-  Real h = 1;     // m
   Real norm = 0;  // Pa·s/m⁶
 
   template <class V>
-  SWIRL_LAW_INLINE V term(const V& vol_j, const V& r) const {
-    const V q = law_detail::max_of(V(h) - r, V(Real(0)));
+  SWIRL_LAW_INLINE V term(const V& vol_j, const V& q) const {
     return vol_j * q;
   }
 };
@@ -154,10 +151,16 @@ struct SphLaws {
     // The spiky gradient's norm is negative (∇W points back to j): its
     // negative is the push away from j.
     const Real half = form == PressureForm::Thesis ? Real(0.5) : Real(1);
-    pressure.h = h;
     pressure.norm = -Spiky<Real>(h).grad_norm * half;
-    viscosity.h = h;
     viscosity.norm = mu * Viscosity<Real>(h).laplacian_norm;
+  }
+
+  // q = h − r, the factor both force kernels share (∇W_spiky ∝ (h − r)²,
+  // ∇²W_visc ∝ h − r), clamped at 0: r computed as r² · (1/r) may exceed h by
+  // a rounding for r² < h². One h for both laws, so that a pair computes it once.
+  template <class V>
+  SWIRL_LAW_INLINE V gap(const V& r) const {
+    return law_detail::max_of(V(h) - r, V(Real(0)));
   }
 
   // a_i = f_i / ρ_i (eq. 2.6) from the unnormalised sums of particle i:

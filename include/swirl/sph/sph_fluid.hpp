@@ -213,10 +213,10 @@ class SphFluid final : public ForceModel<Real> {
         for (std::size_t k = L.offsets[row]; k < L.offsets[row + 1]; ++k) {
           const std::uint32_t j = L.neighbor[k];
           // 1/r = 0 at r = 0 (coincident particles): no pressure force without a direction.
-          const Real r = std::sqrt(L.r2[k]), inv_r = r > Real(0) ? Real(1) / r : Real(0);
+          const Real r = std::sqrt(L.r2[k]), inv_r = r > Real(0) ? Real(1) / r : Real(0), q = laws.gap(r);
           const Real vol_j = m[j] / rho[j];
-          const Real fp = laws.pressure.term(pr[i], vol_j, pr[j] * vol_j, r, inv_r);  // along r⃗ = x_i − x_j
-          const Real fv = laws.viscosity.term(vol_j, r);
+          const Real fp = laws.pressure.term(pr[i], vol_j, pr[j] * vol_j, q, inv_r);  // along r⃗ = x_i − x_j
+          const Real fv = laws.viscosity.term(vol_j, q);
           px += fp * (x[i] - x[j]);
           py += fp * (y[i] - y[j]);
           pz += fp * (z[i] - z[j]);
