@@ -67,9 +67,12 @@ std::uint64_t density_cell(const DensityKernelArgs<Real>& a, std::size_t first, 
   constexpr std::size_t W = kLanes<Real>;
   const Real *x = a.x, *y = a.y, *z = a.z, *m = a.mass;
   const std::size_t n = a.n;
-  const SphLaws<Real> laws = a.laws;  // a local copy: the stores below cannot alias it
+  // A local copy: the stores to the particle arrays below cannot alias it, so
+  // h² stays in a register across the ranges (with a reference it was reloaded
+  // per range: +4 % instructions per cell in the AVX2 copy, callgrind).
+  const SphLaws<Real> laws = a.laws;
   const Real h2 = laws.h2;
-  const B iota = lane_numbers<Real>(), hh(h2), zero(Real(0)), one(Real(1));
+  const B iota = lane_numbers<Real>(), zero(Real(0)), one(Real(1));
   std::uint64_t pairs = 0;
   for (std::size_t i = first; i < last; ++i) {
     const B xi(x[i]), yi(y[i]), zi(z[i]);
@@ -82,15 +85,17 @@ std::uint64_t density_cell(const DensityKernelArgs<Real>& a, std::size_t first, 
       for (; j < end && j + W <= n; j += W) {
         const B dx = xi - B::load_unaligned(x + j), dy = yi - B::load_unaligned(y + j), dz = zi - B::load_unaligned(z + j);
         const B r2 = dx * dx + dy * dy + dz * dz;
-        const auto in = (r2 < hh) & (iota < B(live_lanes<Real>(end - j)));
-        acc += xsimd::select(in, laws.density.term(B::load_unaligned(m + j), r2), zero);
+        // h² − r² > 0 exactly when r² < h² (a difference of finite floats is 0 only if they are equal).
+        const B d = laws.gap2(r2);
+        const auto in = (d > zero) & (iota < B(live_lanes<Real>(end - j)));
+        acc += xsimd::select(in, laws.density.term(B::load_unaligned(m + j), d), zero);
         hits += xsimd::select(in, one, zero);
       }
       for (; j < end; ++j) {  // the last particles of the array: no full batch to load
         const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
         const Real r2 = dx * dx + dy * dy + dz * dz;
         if (r2 < h2) {
-          tail += laws.density.term(m[j], r2);
+          tail += laws.density.term(m[j], laws.gap2(r2));
           ++found;
         }
       }
@@ -115,7 +120,9 @@ void forces_cell(const ForceKernelArgs<Real>& a, std::size_t first, std::size_t 
   const Real *x = a.x, *y = a.y, *z = a.z, *vx = a.vx, *vy = a.vy, *vz = a.vz;
   const Real *V = a.volume, *PV = a.pressure_volume, *pr = a.pressure;
   const std::size_t n = a.n;
-  const SphLaws<Real> laws = a.laws;  // a local copy: the stores below cannot alias it
+  // By reference here: nothing is reloaded per pair, and a local copy measured
+  // more instructions per cell in this longer loop (AVX2 copy, callgrind).
+  const SphLaws<Real>& laws = a.laws;
   const Real h2 = laws.h2;
   const B iota = lane_numbers<Real>(), hh(h2), zero(Real(0)), one(Real(1));
   for (std::size_t i = first; i < last; ++i) {

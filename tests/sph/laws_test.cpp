@@ -67,7 +67,7 @@ TYPED_TEST(LawTest, DensityIsTheMassWeightedPoly6Sum) {
   Real sum = 0;
   for (int k = 0; k < 4; ++k) {
     expected += m[k] * 315 / (64 * kPi * std::pow(h, 9)) * std::pow(h * h - r[k] * r[k], 3);
-    sum += laws.density.term(Real(m[k]), Real(r[k] * r[k]));
+    sum += laws.density.term(Real(m[k]), laws.gap2(Real(r[k] * r[k])));
   }
   EXPECT_NEAR(double(laws.density.density(sum)), expected, 4 * rel_tol<Real>() * expected);
 }
@@ -134,11 +134,11 @@ TYPED_TEST(LawTest, BatchesEvaluateTheSameLaws) {
   }
   const B rb = B::load_aligned(r), mb = B::load_aligned(m), pb = B::load_aligned(p), vb = B::load_aligned(vol);
   alignas(64) Real density[W], pressure[W], viscosity[W];
-  laws.density.term(mb, rb * rb).store_aligned(density);
+  laws.density.term(mb, laws.gap2(rb * rb)).store_aligned(density);
   laws.pressure.term(B(Real(7)), vb, pb * vb, laws.gap(rb), B(Real(1)) / rb).store_aligned(pressure);
   laws.viscosity.term(vb, laws.gap(rb)).store_aligned(viscosity);
   for (std::size_t k = 0; k < W; ++k) {
-    const Real d = laws.density.term(m[k], r[k] * r[k]);
+    const Real d = laws.density.term(m[k], laws.gap2(r[k] * r[k]));
     const Real f = laws.pressure.term(Real(7), vol[k], p[k] * vol[k], laws.gap(r[k]), Real(1) / r[k]);
     const Real v = laws.viscosity.term(vol[k], laws.gap(r[k]));
     EXPECT_NEAR(double(density[k]), double(d), 8 * rel_tol<Real>() * std::abs(double(d))) << k;

@@ -78,28 +78,23 @@ inline Real inverse_distance(Real r2s) {
   return r2s > Real(0) ? Real(1) / std::sqrt(r2s) : Real(0);
 }
 
-// The point-mass law's two factors for inv = 1/R: m/R³ (times d for the
-// acceleration) and m/R (the potential's magnitude).
+// m/R³ from m/R and 1/R: the point-mass law's factor of d in the acceleration
+// (m/R itself is the potential's magnitude).
 template <class V>
-struct PointFactors {
-  V accel, m_inv;
-};
-
-template <class V>
-SWIRL_LAW_INLINE PointFactors<V> point_factors(const V& m, const V& inv) {
-  const V m_inv = m * inv;
-  return {m_inv * (inv * inv), m_inv};
+SWIRL_LAW_INLINE V point_accel(const V& m_inv, const V& inv) {
+  return m_inv * (inv * inv);
 }
 
 // Point mass m at d: a += m d / R³, φ −= m / R.
 template <class V, class Sums>
 SWIRL_LAW_INLINE void add_point(const V& dx, const V& dy, const V& dz, const V& m, const V& inv, Sums& s) {
   using law_detail::madd;
-  const PointFactors<V> f = point_factors(m, inv);
-  s.ax = madd(f.accel, dx, s.ax);
-  s.ay = madd(f.accel, dy, s.ay);
-  s.az = madd(f.accel, dz, s.az);
-  s.phi = s.phi - f.m_inv;
+  const V m_inv = m * inv;
+  const V accel = point_accel(m_inv, inv);
+  s.ax = madd(accel, dx, s.ax);
+  s.ay = madd(accel, dy, s.ay);
+  s.az = madd(accel, dz, s.az);
+  s.phi = s.phi - m_inv;
 }
 
 // A cell's traceless quadrupole (zz = −xx − yy).
@@ -142,8 +137,9 @@ struct PairTerm {
 
 template <class Real>
 inline PairTerm<Real> pair_term(Real dx, Real dy, Real dz, Real mass, Real eps2) {
-  const PointFactors<Real> f = point_factors(mass, inverse_distance(dx * dx + dy * dy + dz * dz + eps2));
-  return {f.accel, -f.m_inv};
+  const Real inv = inverse_distance(dx * dx + dy * dy + dz * dz + eps2);
+  const Real m_inv = mass * inv;
+  return {point_accel(m_inv, inv), -m_inv};
 }
 
 // Per-particle sums of the laws (scalar code).

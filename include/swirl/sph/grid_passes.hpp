@@ -147,7 +147,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
               for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j) {
                 const Real r2 = spatial::distance2(x[i], y[i], z[i], x[j], y[j], z[j]);
                 if (spatial::within(r2, h2)) {
-                  sum += laws.density.term(m[j], r2);
+                  sum += laws.density.term(m[j], laws.gap2(r2));
                   ++found;
                 }
               }

@@ -16,9 +16,11 @@
 // on Real (scalar loops) and on xsimd batches (the SIMD loop, one pair per
 // lane). Contract of every pair function: it is called only for pairs with
 // r < h (the caller tests r² < h² and masks or skips the others; outside, the
-// value is meaningless, not 0), and returns the pair's part of the sum with the
-// constant factors left out; the factors (norm) are applied once per particle,
-// after the sum, so that a pair costs no division but 1/r.
+// value is meaningless, not 0), takes the kernel's gap (h² − r² or h − r,
+// from SphLaws::gap2/gap: one h for all the laws, so that a pair computes it
+// once) and returns the pair's part of the sum with the constant factors left
+// out; the factors (norm) are applied once per particle, after the sum, so
+// that a pair costs no division but 1/r.
 //
 // The evaluate functions are force-inlined: the SIMD copies instantiate them
 // (with batches and, in their scalar tails, with Real) inside code compiled for
@@ -74,16 +76,14 @@ struct EquationOfState {
 // Density (eq. 2.3 with W_poly6, eq. 2.11):
 //   ρ_i = Σ_j m_j W_poly6(r_ij) = norm · Σ_j m_j (h² − r_ij²)³,   norm = 315 / (64 π h⁹)
 // the sum over every j with r_ij < h, i itself included (r = 0).
-// term() is one j's m_j (h² − r²)³ (no square root); density() applies norm
-// to the finished sum.
+// term() is one j's m_j (h² − r²)³ from d = h² − r² (SphLaws::gap2(r²): no
+// square root); density() applies norm to the finished sum.
 template <class Real>
 struct DensityLaw {
-  Real h2 = 1;    // m²
   Real norm = 0;  // 1/m⁹
 
   template <class V>
-  SWIRL_LAW_INLINE V term(const V& m_j, const V& r2) const {
-    const V d = V(h2) - r2;
+  SWIRL_LAW_INLINE V term(const V& m_j, const V& d) const {
     return m_j * d * d * d;
   }
   template <class V>
@@ -131,7 +131,9 @@ struct ViscosityLaw {
 // constants every driver uses are these, rounded once).
 template <class Real>
 struct SphLaws {
-  Real h = 1, h2 = 1;  // support radius and its square, m, m² (pairs need r² < h²)
+  // Support radius and its square, m, m²: the pairs are r² < h², and the gaps
+  // below are the kernels' shared factors, so that one h serves every law.
+  Real h = 1, h2 = 1;
   EquationOfState<Real> eos;
   DensityLaw<Real> density;
   PressureLaw<Real> pressure;
@@ -145,14 +147,19 @@ struct SphLaws {
                 Real(params.viscosity), params.pressure_form) {}
   // From the constants in Real: h (m), the equation of state, μ (Pa·s) and the form of eq. 2.8.
   SphLaws(Real h_, const EquationOfState<Real>& eos_, Real mu, PressureForm form) : h(h_), h2(h_ * h_), eos(eos_) {
-    const Poly6<Real> poly6(h);
-    density.h2 = poly6.h2;
-    density.norm = poly6.norm;
+    density.norm = Poly6<Real>(h).norm;
     // The spiky gradient's norm is negative (∇W points back to j): its
     // negative is the push away from j.
     const Real half = form == PressureForm::Thesis ? Real(0.5) : Real(1);
     pressure.norm = -Spiky<Real>(h).grad_norm * half;
     viscosity.norm = mu * Viscosity<Real>(h).laplacian_norm;
+  }
+
+  // d = h² − r², the factor of W_poly6 (the density law's argument; > 0 for
+  // the pairs, r² < h²).
+  template <class V>
+  SWIRL_LAW_INLINE V gap2(const V& r2) const {
+    return V(h2) - r2;
   }
 
   // q = h − r, the factor both force kernels share (∇W_spiky ∝ (h − r)²,

@@ -176,8 +176,9 @@ class SphFluid final : public ForceModel<Real> {
       hash_.find_neighbors(p, params_.duplicate_check, ctx.block_size, lists_,
                            [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t count) {
                              // The particle itself (r = 0), then its neighbours (all r < h).
-                             Real sum = laws.density.term(m[i], Real(0));
-                             for (std::size_t k = 0; k < count; ++k) sum += laws.density.term(m[nb[k]], r2[k]);
+                             Real sum = laws.density.term(m[i], laws.gap2(Real(0)));
+                             for (std::size_t k = 0; k < count; ++k)
+                               sum += laws.density.term(m[nb[k]], laws.gap2(r2[k]));
                              rho[i] = laws.density.density(sum);
                              pressure[i] = laws.eos.pressure(rho[i]);
                            });
