@@ -69,16 +69,8 @@ sph::SphParameters params_for(std::size_t n, sph::NeighbourSearch search, bool s
   return s;
 }
 
-sph::GridPassConstants<Real> constants(const sph::SphParameters& s) {
-  sph::GridPassConstants<Real> k;
-  k.h = Real(s.smoothing_length);
-  k.h2 = k.h * k.h;
-  k.rest_density = Real(s.rest_density);
-  k.c2 = Real(s.sound_speed * s.sound_speed);
-  k.pressure_floor = -1e30f;
-  k.mu = Real(s.viscosity);
-  return k;
-}
+// The laws of the fluid (sph/laws.hpp), as SphFluid builds them.
+sph::SphLaws<Real> constants(const sph::SphParameters& s) { return sph::SphLaws<Real>(s); }
 
 // "simd <instruction set>" or "scalar".
 std::string simd_label(bool simd) {
@@ -278,16 +270,13 @@ void BM_Lists(benchmark::State& state) {
   spatial::ParticleOrder<Real> order;  // the grid is a view of it
   evaluate_alone(fluid, p, order, kBlock);
   const auto k = constants(s);
-  const sph::Poly6<Real> w(k.h);
-  const sph::Spiky<Real> spiky(k.h);
-  const sph::Viscosity<Real> visc(k.h);
   std::vector<BlockLists> lists;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
   Real *rho = p.density.data(), *pr = p.pressure.data(), *ax = p.acceleration.x.data();
   Real *ay = p.acceleration.y.data(), *az = p.acceleration.z.data();
   std::vector<Real> V(n), PV(n);
-  const Real pn = -spiky.grad_norm * k.half, vn = k.mu * visc.laplacian_norm;
+  const Real pn = k.pressure.norm, vn = k.viscosity.norm;
   double pairs = 0;
   double t_build = 0, t_density = 0, t_forces = 0;
   using Clock = std::chrono::steady_clock;
@@ -323,8 +312,8 @@ void BM_Lists(benchmark::State& state) {
           sum += m[L.j[q]] * d * d * d;
         }
         from = to;
-        rho[i] = w.norm * sum;
-        pr[i] = k.c2 * (rho[i] - k.rest_density);
+        rho[i] = k.density.norm * sum;
+        pr[i] = k.eos.c2 * (rho[i] - k.eos.rest_density);
         V[i] = m[i] / rho[i];
         PV[i] = pr[i] * V[i];
       }

@@ -41,41 +41,35 @@ void particle_field_scalar(const SourceParticles<Real>& s, const Targets<Real>& 
   }
 }
 
-template <class Real>
-void cell_field_scalar(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, bool quadrupole) {
+// law(j, dx, dy, dz, inv, acc) adds cell j's term to acc.
+template <class Real, class Law>
+void cells_scalar(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, Law&& law) {
   for (std::size_t i = 0; i < t.n; ++i) {
     const Real tx = t.x[i], ty = t.y[i], tz = t.z[i];
-    Real ax = 0, ay = 0, az = 0, phi = 0;
+    Accumulator<Real> acc;
     for (std::size_t j = 0; j < s.n; ++j) {
       const Real dx = s.x[j] - tx, dy = s.y[j] - ty, dz = s.z[j] - tz;
-      const Real r2s = dx * dx + dy * dy + dz * dz + eps2;
-      const Real inv = r2s > Real(0) ? Real(1) / std::sqrt(r2s) : Real(0);
-      const Real inv2 = inv * inv;
-      const Real m_inv = s.m[j] * inv;
-      const Real m_inv3 = m_inv * inv2;
-      ax += m_inv3 * dx;
-      ay += m_inv3 * dy;
-      az += m_inv3 * dz;
-      phi -= m_inv;
-      if (quadrupole) {
-        // φ −= ½ rᵀQr / R⁵, a = −∇φ; r = target − centre of mass = −(dx, dy, dz).
-        const Real qzz = -(s.qxx[j] + s.qyy[j]);
-        const Real qx = s.qxx[j] * dx + s.qxy[j] * dy + s.qxz[j] * dz;
-        const Real qy = s.qxy[j] * dx + s.qyy[j] * dy + s.qyz[j] * dz;
-        const Real qz = s.qxz[j] * dx + s.qyz[j] * dy + qzz * dz;
-        const Real q = dx * qx + dy * qy + dz * qz;
-        const Real inv5 = inv * inv2 * inv2, inv7 = inv5 * inv2;
-        const Real radial = Real(2.5) * q * inv7;
-        ax += radial * dx - qx * inv5;
-        ay += radial * dy - qy * inv5;
-        az += radial * dz - qz * inv5;
-        phi -= Real(0.5) * q * inv5;
-      }
+      law(j, dx, dy, dz, inverse_distance(dx * dx + dy * dy + dz * dz + eps2), acc);
     }
-    t.ax[i] += ax;
-    t.ay[i] += ay;
-    t.az[i] += az;
-    t.phi[i] += phi;
+    t.ax[i] += acc.ax;
+    t.ay[i] += acc.ay;
+    t.az[i] += acc.az;
+    t.phi[i] += acc.phi;
+  }
+}
+
+template <class Real>
+void cell_field_scalar(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, bool quadrupole) {
+  // The law is chosen once per call, not per interaction.
+  if (quadrupole) {
+    cells_scalar(s, t, eps2, [&](std::size_t j, Real dx, Real dy, Real dz, Real inv, Accumulator<Real>& acc) {
+      const Quadrupole<Real> Q{s.qxx[j], s.qxy[j], s.qxz[j], s.qyy[j], s.qyz[j], -(s.qxx[j] + s.qyy[j])};
+      add_cell(dx, dy, dz, s.m[j], Q, inv, acc);
+    });
+  } else {
+    cells_scalar(s, t, eps2, [&](std::size_t j, Real dx, Real dy, Real dz, Real inv, Accumulator<Real>& acc) {
+      add_point(dx, dy, dz, s.m[j], inv, acc);
+    });
   }
 }
 

@@ -26,6 +26,7 @@
 
 #include "swirl/core/simd_rsqrt.hpp"
 #include "swirl/gravity/interaction_kernels.hpp"
+#include "swirl/gravity/pair_law.hpp"
 
 // GCC 12 reports the deliberately undefined pass-through operand of the
 // AVX-512 intrinsics xsimd calls (_mm512_undefined_ps) as maybe-uninitialized
@@ -79,58 +80,33 @@ struct Sums {
   Batch<T> ax = Batch<T>(T(0)), ay = Batch<T>(T(0)), az = Batch<T>(T(0)), phi = Batch<T>(T(0));
 };
 
-// The pair law of point masses m at d = source − target (per lane; m = 0
-// in a lane that must not count), with z = c/R (c = Root<T>::scale):
-// ax += c³ m dx / R³, phi += c m / R (kPoint*Factor undo c and the sign).
+// The pair law (gravity/pair_law.hpp) of point masses m at d = source −
+// target (per lane; m = 0 in a lane that must not count), with z = c/R (c =
+// Root<T>::scale) for 1/R: the sums collect c³ m d / R³ and −c m / R, and
+// kPoint*Factor undo c when they are stored (exact: c is a power of 2).
 template <class T, bool Guard>
 inline void point_law(const Batch<T>& dx, const Batch<T>& dy, const Batch<T>& dz, const Batch<T>& m,
                       const Batch<T>& eps2, Sums<T>& sums) {
-  using B = Batch<T>;
-  const B r2 = xsimd::fma(dx, dx, xsimd::fma(dy, dy, xsimd::fma(dz, dz, eps2)));
-  const B inv = scaled_inverse_sqrt<T, Guard>(r2);
-  const B m_inv = m * inv;
-  const B m_inv3 = m_inv * (inv * inv);
-  sums.ax = xsimd::fma(m_inv3, dx, sums.ax);
-  sums.ay = xsimd::fma(m_inv3, dy, sums.ay);
-  sums.az = xsimd::fma(m_inv3, dz, sums.az);
-  sums.phi = sums.phi + m_inv;
+  const Batch<T> r2 = xsimd::fma(dx, dx, xsimd::fma(dy, dy, xsimd::fma(dz, dz, eps2)));
+  add_point(dx, dy, dz, m, scaled_inverse_sqrt<T, Guard>(r2), sums);
 }
 
 template <class T>
 constexpr T kPointAccelFactor = T(1) / (Root<T>::scale * Root<T>::scale * Root<T>::scale);
 template <class T>
-constexpr T kPointPotentialFactor = -T(1) / Root<T>::scale;
+constexpr T kPointPotentialFactor = T(1) / Root<T>::scale;
 
-// A cell's traceless quadrupole per lane.
-template <class T>
-struct Quadrupole {
-  Batch<T> xx, xy, xz, yy, yz, zz;
-};
-
-// Monopole and quadrupole of cells at d = centre of mass − target: phi
-// collects +m/R + ½ rᵀQr/R⁵ (the potential factor −1 negates it).
+// Monopole and quadrupole (pair_law.hpp's add_cell) of cells at d = centre of
+// mass − target, with 1/R unscaled first (the quadrupole's powers of 1/R do
+// not fold into one factor).
 template <class T, bool Guard>
 inline void quadrupole_law(const Batch<T>& dx, const Batch<T>& dy, const Batch<T>& dz, const Batch<T>& m,
-                           const Quadrupole<T>& Q, const Batch<T>& eps2, Sums<T>& sums) {
+                           const Quadrupole<Batch<T>>& Q, const Batch<T>& eps2, Sums<T>& sums) {
   using B = Batch<T>;
   const B r2 = xsimd::fma(dx, dx, xsimd::fma(dy, dy, xsimd::fma(dz, dz, eps2)));
   B inv = scaled_inverse_sqrt<T, Guard>(r2);
   if constexpr (Root<T>::scale != T(1)) inv = inv * B(T(1) / Root<T>::scale);
-  const B inv2 = inv * inv;
-  const B m_inv = m * inv;
-  // φ −= ½ rᵀQr / R⁵, a = −∇φ = (2.5 rᵀQr/R⁷) d − Qd/R⁵ with r = −d (the
-  // quadratic form is even in r, Qr odd).
-  const B qx = xsimd::fma(Q.xx, dx, xsimd::fma(Q.xy, dy, Q.xz * dz));
-  const B qy = xsimd::fma(Q.xy, dx, xsimd::fma(Q.yy, dy, Q.yz * dz));
-  const B qz = xsimd::fma(Q.xz, dx, xsimd::fma(Q.yz, dy, Q.zz * dz));
-  const B q = xsimd::fma(dx, qx, xsimd::fma(dy, qy, dz * qz));
-  const B inv5 = inv * (inv2 * inv2);
-  const B q5 = q * inv5;
-  const B radial = xsimd::fma(B(T(2.5)) * q5, inv2, m_inv * inv2);  // the coefficient of d in a
-  sums.ax = xsimd::fma(radial, dx, xsimd::fnma(qx, inv5, sums.ax));
-  sums.ay = xsimd::fma(radial, dy, xsimd::fnma(qy, inv5, sums.ay));
-  sums.az = xsimd::fma(radial, dz, xsimd::fnma(qz, inv5, sums.az));
-  sums.phi = sums.phi + xsimd::fma(B(T(0.5)), q5, m_inv);
+  add_cell(dx, dy, dz, m, Q, inv, sums);
 }
 
 template <class T>
@@ -212,7 +188,7 @@ template <class T, bool Guard>
 inline void batch_cell(const SourceCells<T>& s, std::size_t j, const TargetBatch<T>& b, const Batch<T>& eps2,
                        Sums<T>& sums) {
   using B = Batch<T>;
-  const Quadrupole<T> Q{B(s.qxx[j]), B(s.qxy[j]), B(s.qxz[j]), B(s.qyy[j]), B(s.qyz[j]), B(-(s.qxx[j] + s.qyy[j]))};
+  const Quadrupole<Batch<T>> Q{B(s.qxx[j]), B(s.qxy[j]), B(s.qxz[j]), B(s.qyy[j]), B(s.qyz[j]), B(-(s.qxx[j] + s.qyy[j]))};
   quadrupole_law<T, Guard>(B(s.x[j]) - b.x, B(s.y[j]) - b.y, B(s.z[j]) - b.z, B(s.m[j]), Q, eps2, sums);
 }
 
@@ -227,7 +203,7 @@ void cells_on_batch(const SourceCells<T>& s, const Targets<T>& t, std::size_t be
       batch_cell<T, Guard>(s, j + 1, b, eps2, s1);
     }
     if (j < s.n) batch_cell<T, Guard>(s, j, b, eps2, s0);
-    store_batch(t, begin, s0, s1, T(1), T(-1));
+    store_batch(t, begin, s0, s1, T(1), T(1));
   } else {
     const SourceParticles<T> points{s.x, s.y, s.z, s.m, s.n};
     batch_points<T, Guard>(points, 0, s.n, b, eps2, s0, s1);
@@ -296,7 +272,7 @@ void cells_on_target(const SourceCells<T>& s, const Targets<T>& t, std::size_t i
     auto add = [&](const T* x, const T* y, const T* z, const T* m, const T* qxx, const T* qxy, const T* qxz,
                    const T* qyy, const T* qyz, Sums<T>& into) {
       const B xx = B::load_unaligned(qxx), yy = B::load_unaligned(qyy);
-      const Quadrupole<T> Q{xx, B::load_unaligned(qxy), B::load_unaligned(qxz), yy, B::load_unaligned(qyz), -(xx + yy)};
+      const Quadrupole<Batch<T>> Q{xx, B::load_unaligned(qxy), B::load_unaligned(qxz), yy, B::load_unaligned(qyz), -(xx + yy)};
       quadrupole_law<T, Guard>(B::load_unaligned(x) - tx, B::load_unaligned(y) - ty, B::load_unaligned(z) - tz,
                                B::load_unaligned(m), Q, eps2, into);
     };
@@ -319,7 +295,7 @@ void cells_on_target(const SourceCells<T>& s, const Targets<T>& t, std::size_t i
       }
       add(x, y, z, m, qxx, qxy, qxz, qyy, qyz, sums[k]);
     }
-    store_target(t, i, sums[0], sums[1], T(1), T(-1));
+    store_target(t, i, sums[0], sums[1], T(1), T(1));
   }
 }
 

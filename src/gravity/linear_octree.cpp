@@ -12,6 +12,7 @@
 
 #include "swirl/core/morton.hpp"
 #include "swirl/gravity/interaction_kernels.hpp"
+#include "swirl/gravity/pair_law.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::gravity {
@@ -411,27 +412,12 @@ void LinearOctree<Real>::walk_one(std::size_t s, Accumulator<Real>& acc, WalkCou
     const bool holds_target = slot - t.begin[n] < t.end[n] - t.begin[n];  // begin ≤ s < end, unsigned
     if (!holds_target && r2 > t.open2[n]) {
       ++counts.multipoles;
-      const Real r2s = r2 + eps2;
-      const Real inv = r2s > Real(0) ? Real(1) / std::sqrt(r2s) : Real(0);
-      const Real inv2 = inv * inv;
-      const Real m_inv3 = t.mass[n] * inv * inv2;
-      acc.ax += m_inv3 * dx;
-      acc.ay += m_inv3 * dy;
-      acc.az += m_inv3 * dz;
-      acc.phi -= t.mass[n] * inv;
+      const Real inv = inverse_distance(r2 + eps2);
       if (quadrupole) {
-        // φ −= ½ rᵀQr / r⁵, a = −∇φ; r = particle − centre of mass = −(dx, dy, dz).
-        const Real qzz = -(t.qxx[n] + t.qyy[n]);
-        const Real qx = t.qxx[n] * dx + t.qxy[n] * dy + t.qxz[n] * dz;
-        const Real qy = t.qxy[n] * dx + t.qyy[n] * dy + t.qyz[n] * dz;
-        const Real qz = t.qxz[n] * dx + t.qyz[n] * dy + qzz * dz;
-        const Real q = dx * qx + dy * qy + dz * qz;
-        const Real inv5 = inv * inv2 * inv2, inv7 = inv5 * inv2;
-        const Real radial = Real(2.5) * q * inv7;
-        acc.ax += radial * dx - qx * inv5;
-        acc.ay += radial * dy - qy * inv5;
-        acc.az += radial * dz - qz * inv5;
-        acc.phi -= Real(0.5) * q * inv5;
+        const Quadrupole<Real> Q{t.qxx[n], t.qxy[n], t.qxz[n], t.qyy[n], t.qyz[n], -(t.qxx[n] + t.qyy[n])};
+        add_cell(dx, dy, dz, t.mass[n], Q, inv, acc);
+      } else {
+        add_point(dx, dy, dz, t.mass[n], inv, acc);
       }
     } else if (t.child_count[n] == 0) {
       const std::uint32_t first = t.begin[n], last = t.end[n];

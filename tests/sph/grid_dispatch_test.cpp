@@ -50,7 +50,7 @@ struct Box {
   sph::SphParameters params;
   sph::SphFluid<Real> fluid;
   spatial::ParticleOrder<Real> order;  // the grid is a view of it
-  sph::GridPassConstants<Real> k;
+  sph::SphLaws<Real> k;
 
   static sph::SphParameters parameters() {
     sph::SphParameters s;
@@ -63,7 +63,7 @@ struct Box {
     return s;
   }
 
-  Box() : p(kParticles), params(parameters()), fluid(params) {
+  Box() : p(kParticles), params(parameters()), fluid(params), k(params) {
     SplitMix64 rng(8);
     for (std::size_t i = 0; i < p.size(); ++i) {
       for (int a = 0; a < 3; ++a) {
@@ -75,12 +75,6 @@ struct Box {
     }
     swirl::evaluate_alone(fluid, p, order, kBlock);  // sorts p into cell order, builds the grid
     if (!fluid.used_grid()) throw std::runtime_error("test set-up: the grid was not used");
-    k.h = Real(params.smoothing_length);
-    k.h2 = k.h * k.h;
-    k.rest_density = Real(params.rest_density);
-    k.c2 = Real(params.sound_speed * params.sound_speed);
-    k.pressure_floor = -std::numeric_limits<Real>::infinity();
-    k.mu = Real(params.viscosity);
   }
 };
 

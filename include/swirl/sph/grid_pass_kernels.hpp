@@ -8,8 +8,9 @@
 // `count` candidate ranges of the cells around it; every candidate j is
 // distance-tested (r² < h², lanes past a range masked), so the pairs are
 // exactly the scalar twin's. Arrays are the sorted-order particle fields; the
-// argument structs hold plain pointers and constants (SI units, as in
-// sph_fluid.hpp) so the per-ISA objects need no library header.
+// argument structs hold plain pointers and the laws (sph/laws.hpp: plain data
+// and force-inlined templates, SI units) so that the per-ISA objects define no
+// function of a library header.
 // Within one instruction set a particle's result depends only on the inputs,
 // never on the thread or block that computes it; across instruction sets the
 // summation order (batch width, FMA contraction), and so the last bits, differ.
@@ -17,6 +18,8 @@
 
 #include <cstddef>
 #include <cstdint>
+
+#include "swirl/sph/laws.hpp"
 
 namespace swirl::sph {
 
@@ -32,8 +35,7 @@ struct DensityKernelArgs {
   Real *density = nullptr, *pressure = nullptr;
   Real *volume = nullptr, *pressure_volume = nullptr;  // m_i / ρ_i and p_i m_i / ρ_i
   std::size_t n = 0;                                   // particles (loads stay below n)
-  Real h2 = 1, poly6_norm = 1;                         // ρ = poly6_norm Σ m_j (h² − r²)³
-  Real rest_density = 1000, c2 = 100, pressure_floor = 0;
+  SphLaws<Real> laws;                                  // density law and equation of state
 };
 
 // Inputs and outputs of the force pass (grid_forces()).
@@ -44,8 +46,7 @@ struct ForceKernelArgs {
   const Real *volume = nullptr, *pressure_volume = nullptr, *pressure = nullptr, *density = nullptr;
   Real *ax = nullptr, *ay = nullptr, *az = nullptr;  // accumulated into (+=)
   std::size_t n = 0;
-  Real h = 1, h2 = 1;
-  Real pressure_norm = 0, visc_norm = 0;  // −½ ∇W_spiky norm (or −1×), μ ∇²W_visc norm
+  SphLaws<Real> laws;  // pressure and viscosity laws
 };
 
 // Density and pressure (and the scratch) of particles [first, last); returns

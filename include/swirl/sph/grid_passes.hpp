@@ -4,6 +4,8 @@
 //                   eq. 2.3) and p_i from the equation of state (eq. 2.9);
 //   grid_forces():  a_i += f_i / ρ_i with the pressure (eq. 2.8) and viscosity
 //                   (eq. 2.10) forces of sph_fluid.hpp.
+// The laws themselves are sph/laws.hpp's evaluators (SphLaws): these loops
+// only find the pairs, sum the evaluators' terms and store the results.
 //
 // Both walk the particles in memory (= cell) order; the particles of one cell
 // share its neighbour ranges (spatial::NeighbourRanges), which are scanned
@@ -17,7 +19,7 @@
 //    and the width is chosen at run time, not by the build's flags: the widest
 //    the CPU runs (16 floats with AVX-512, 8 with AVX2 + FMA, 4 with SSE2), or
 //    the one SWIRL_SIMD names (core/simd_dispatch.hpp);
-//  - Simd = false: the scalar twin (the same formulas one pair at a time), the
+//  - Simd = false: the scalar twin (the same evaluators one pair at a time), the
 //    reference the SIMD path is tested against and the "without vectorisation"
 //    of the benchmark.
 // Each particle's sums are gathered into its own entries in a fixed order that
@@ -40,16 +42,24 @@
 #include "swirl/spatial/cell_grid.hpp"
 #include "swirl/spatial/distance.hpp"
 #include "swirl/sph/grid_pass_kernels.hpp"
-#include "swirl/sph/kernels.hpp"
+#include "swirl/sph/laws.hpp"
 
 namespace swirl::sph {
 
-// The constants of the two passes, from the parameters of sph_fluid.hpp.
+// The grid path of sph_fluid.hpp still fills these (that file is being
+// restructured on another branch and this one leaves its grid path alone):
+// converted to SphLaws, the one set of constants, once per pass. Remove with
+// that path's next edit (it becomes `const SphLaws<Real> laws(params_);`).
 template <class Real>
 struct GridPassConstants {
   Real h = 1, h2 = 1;
   Real rest_density = 1000, c2 = 100, pressure_floor = 0;  // p = max(floor, c² (ρ − ρ0))
   Real mu = 0, half = Real(0.5);                          // viscosity; ½ for eq. 2.8, 1 consistent
+
+  SphLaws<Real> laws() const {
+    return SphLaws<Real>(h, {rest_density, c2, pressure_floor}, mu,
+                         half == Real(1) ? PressureForm::Consistent : PressureForm::Thesis);
+  }
 };
 
 // Per-particle values the density pass leaves for the force pass (sorted
@@ -99,14 +109,12 @@ struct KernelRanges {
 // Density and pressure of every particle; returns the neighbour pairs found
 // (self excluded), for the mean neighbour count.
 template <class Real, bool Simd>
-std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
-                           const GridPassConstants<Real>& k, std::size_t block_size, GridScratch<Real>& scratch) {
+std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
+                           std::size_t block_size, GridScratch<Real>& scratch) {
   const std::size_t n = p.size();
   scratch.volume.resize(n);
   scratch.pressure_volume.resize(n);
   Real *volume = scratch.volume.data(), *pressure_volume = scratch.pressure_volume.data();
-  const Poly6<Real> w(k.h);
-  const Real h2 = w.h2;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real *rho = p.density.data(), *pr = p.pressure.data();
   const auto sum_blocks = [](std::uint64_t a, std::uint64_t b) { return a + b; };
@@ -115,7 +123,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
     DensityKernelArgs<Real> a;
     a.x = x, a.y = y, a.z = z, a.mass = m, a.density = rho, a.pressure = pr;
     a.volume = volume, a.pressure_volume = pressure_volume, a.n = n;
-    a.h2 = h2, a.poly6_norm = w.norm, a.rest_density = k.rest_density, a.c2 = k.c2, a.pressure_floor = k.pressure_floor;
+    a.laws = laws;
     return parallel::reduce_blocks_pinned(
         "sph_grid_density", n, block_size, std::uint64_t{0},
         [&](std::size_t b, std::size_t e) {
@@ -130,6 +138,11 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
     return parallel::reduce_blocks_pinned(
         "sph_grid_density", n, block_size, std::uint64_t{0},
         [&](std::size_t b, std::size_t e) {
+          // A copy in the block: the stores below cannot alias it, so its
+          // constants stay in registers and the pair loop has no load of them
+          // to keep conditional (read through the reference, the pass ran 2.5×
+          // slower natively: g++ no longer vectorised the pair loop).
+          const SphLaws<Real> law = laws;
           std::uint64_t pairs = 0;
           detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
             Real sum = 0;
@@ -137,15 +150,14 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
             for (int r = 0; r < count; ++r)
               for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j) {
                 const Real r2 = spatial::distance2(x[i], y[i], z[i], x[j], y[j], z[j]);
-                if (spatial::within(r2, h2)) {
-                  const Real d = h2 - r2;
-                  sum += m[j] * d * d * d;
+                if (spatial::within(r2, law.h2)) {
+                  sum += law.density.term(m[j], law.gap2(r2));
                   ++found;
                 }
               }
-            const Real density = w.norm * sum;
+            const Real density = law.density.density(sum);
             rho[i] = density;
-            pr[i] = std::max(k.pressure_floor, k.c2 * (density - k.rest_density));
+            pr[i] = law.eos.pressure(density);
             volume[i] = m[i] / density;
             pressure_volume[i] = pr[i] * volume[i];
             pairs += found - 1;  // the particle itself is in its own cell's range
@@ -156,20 +168,20 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
   }
 }
 
-// Adds the pressure and viscosity accelerations (densities, pressures and the
-// scratch from grid_density()). Per pair, with V_j = m_j / ρ_j:
-//   pressure  (p_i V_j + p_j V_j) · ½ · (−∇W_spiky factor) · r⃗      (eq. 2.8)
-//   viscosity μ V_j ∇²W_viscosity · (v_j − v_i)                     (eq. 2.10)
-// the kernel constants applied once per particle.
 template <class Real, bool Simd>
-void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const GridPassConstants<Real>& k,
+std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
+                           const GridPassConstants<Real>& k, std::size_t block_size, GridScratch<Real>& scratch) {
+  return grid_density<Real, Simd>(grid, p, k.laws(), block_size, scratch);
+}
+
+// Adds the pressure and viscosity accelerations (densities, pressures and the
+// scratch from grid_density()): per pair PressureLaw::term · r⃗ and
+// ViscosityLaw::term · (v_j − v_i) summed, SphLaws::acceleration() once per
+// particle.
+template <class Real, bool Simd>
+void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
                  std::size_t block_size, const GridScratch<Real>& scratch) {
   const std::size_t n = p.size();
-  const Spiky<Real> spiky(k.h);
-  const Viscosity<Real> visc(k.h);
-  const Real h = k.h, h2 = k.h * k.h;
-  // grad_norm < 0: the pressure term pushes i away from j.
-  const Real pressure_norm = -spiky.grad_norm * k.half, visc_norm = k.mu * visc.laplacian_norm;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
   const Real *V = scratch.volume.data(), *PV = scratch.pressure_volume.data(), *pr = p.pressure.data();
@@ -181,7 +193,7 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     a.x = x, a.y = y, a.z = z, a.vx = vx, a.vy = vy, a.vz = vz;
     a.volume = V, a.pressure_volume = PV, a.pressure = pr, a.density = rho;
     a.ax = ax, a.ay = ay, a.az = az, a.n = n;
-    a.h = h, a.h2 = h2, a.pressure_norm = pressure_norm, a.visc_norm = visc_norm;
+    a.laws = laws;
     parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
         forces_cell_simd(a, first, last, detail::KernelRanges(ranges, count).data(), count);
@@ -189,37 +201,44 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     });
     return;
   }
-  // The scalar twin: pressure sums (fp) and viscosity sums (fv) of particle i.
+  // The scalar twin: pressure sums (px..) and viscosity sums (vx..) of particle i.
   struct Sums {
     Real px = 0, py = 0, pz = 0, vx = 0, vy = 0, vz = 0;
   };
-  auto pair = [&](std::size_t i, std::size_t j, Sums& s) {
-    const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
-    const Real r2 = dx * dx + dy * dy + dz * dz;
-    if (!spatial::within(r2, h2)) return;
-    const Real r = std::sqrt(r2), q = std::max(h - r, Real(0));
-    const Real g = r > Real(0) ? q * q / r : Real(0);
-    const Real fp = (pr[i] * V[j] + PV[j]) * g;
-    const Real fv = V[j] * q;
-    s.px += fp * dx;
-    s.py += fp * dy;
-    s.pz += fp * dz;
-    s.vx += fv * (vx[j] - vx[i]);
-    s.vy += fv * (vy[j] - vy[i]);
-    s.vz += fv * (vz[j] - vz[i]);
-  };
   parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    const SphLaws<Real> law = laws;  // a copy in the block, as in grid_density (no reloads)
+    auto pair = [&](std::size_t i, std::size_t j, Sums& s) {
+      const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+      const Real r2 = dx * dx + dy * dy + dz * dz;
+      if (!spatial::within(r2, law.h2)) return;
+      // 1/r = 0 at r = 0 takes the pair (i itself, or a coincident j) out of the pressure sum.
+      const Real r = std::sqrt(r2), inv_r = r > Real(0) ? Real(1) / r : Real(0), q = law.gap(r);
+      const Real fp = law.pressure.term(pr[i], V[j], PV[j], q, inv_r);
+      const Real fv = law.viscosity.term(V[j], q);
+      s.px += fp * dx;
+      s.py += fp * dy;
+      s.pz += fp * dz;
+      s.vx += fv * (vx[j] - vx[i]);
+      s.vy += fv * (vy[j] - vy[i]);
+      s.vz += fv * (vz[j] - vz[i]);
+    };
     detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
       Sums s;
       for (int r = 0; r < count; ++r)
         for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j)
           pair(i, j, s);
       const Real inv_rho = Real(1) / rho[i];
-      ax[i] += (pressure_norm * s.px + visc_norm * s.vx) * inv_rho;
-      ay[i] += (pressure_norm * s.py + visc_norm * s.vy) * inv_rho;
-      az[i] += (pressure_norm * s.pz + visc_norm * s.vz) * inv_rho;
+      ax[i] += law.acceleration(s.px, s.vx, inv_rho);
+      ay[i] += law.acceleration(s.py, s.vy, inv_rho);
+      az[i] += law.acceleration(s.pz, s.vz, inv_rho);
     });
   });
+}
+
+template <class Real, bool Simd>
+void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const GridPassConstants<Real>& k,
+                 std::size_t block_size, const GridScratch<Real>& scratch) {
+  grid_forces<Real, Simd>(grid, p, k.laws(), block_size, scratch);
 }
 
 }  // namespace swirl::sph

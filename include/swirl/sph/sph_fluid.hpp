@@ -73,7 +73,7 @@
 #include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sph/grid_passes.hpp"
-#include "swirl/sph/kernels.hpp"
+#include "swirl/sph/laws.hpp"
 #include "swirl/sph/parameters.hpp"
 #include "swirl/spatial/cell_grid.hpp"
 #include "swirl/spatial/particle_order.hpp"
@@ -262,20 +262,18 @@ class SphFluid final : public Solver<Real> {
     }
     {
       PhaseScope phase(ctx, "forces.search");
-      const Poly6<Real> w(h);
-      const Real w0 = w(Real(0)), rho0 = Real(params_.rest_density);
-      const Real floor = params_.negative_pressure == NegativePressure::Zero ? Real(0)
-                                                                              : -std::numeric_limits<Real>::infinity();
-      const Real c2 = Real(params_.sound_speed * params_.sound_speed);
+      const SphLaws<Real> laws(params_);
       const Real* m = p.mass.data();
       Real* rho = p.density.data();
       Real* pressure = p.pressure.data();
       hash_.find_neighbors(p, params_.duplicate_check, ctx.block_size, lists_,
                            [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t count) {
-                             Real sum = m[i] * w0;
-                             for (std::size_t k = 0; k < count; ++k) sum += m[nb[k]] * w(r2[k]);
-                             rho[i] = sum;
-                             pressure[i] = std::max(floor, c2 * (sum - rho0));
+                             // The particle itself (r = 0), then its neighbours (all r < h).
+                             Real sum = laws.density.term(m[i], laws.gap2(Real(0)));
+                             for (std::size_t k = 0; k < count; ++k)
+                               sum += laws.density.term(m[nb[k]], laws.gap2(r2[k]));
+                             rho[i] = laws.density.density(sum);
+                             pressure[i] = laws.eos.pressure(rho[i]);
                            });
     }
     {
@@ -294,10 +292,9 @@ class SphFluid final : public Solver<Real> {
   };
 
   void add_pair_forces(ParticleSet<Real>& p, std::size_t block_size) {
-    const Spiky<Real> spiky(Real(params_.smoothing_length));
-    const Viscosity<Real> visc(Real(params_.smoothing_length));
-    const Real mu = Real(params_.viscosity);
-    const Real half = params_.pressure_form == PressureForm::Thesis ? Real(0.5) : Real(1);
+    // The laws of sph/laws.hpp, as the grid passes use them; V_j = m_j / ρ_j
+    // and p_j V_j are formed per pair here (the lists hold no per-particle scratch).
+    const SphLaws<Real> laws(params_);
     const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
     const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
     const Real *m = p.mass.data(), *rho = p.density.data(), *pr = p.pressure.data();
@@ -306,22 +303,25 @@ class SphFluid final : public Solver<Real> {
     parallel::for_blocks("sph_forces", L.rows(), block_size, [&](std::size_t first, std::size_t last, std::size_t) {
       for (std::size_t row = first; row < last; ++row) {
         const std::uint32_t i = L.row_particle[row];
-        Real fx = 0, fy = 0, fz = 0;
+        Real px = 0, py = 0, pz = 0, qx = 0, qy = 0, qz = 0;  // pressure and viscosity sums
         for (std::size_t k = L.offsets[row]; k < L.offsets[row + 1]; ++k) {
           const std::uint32_t j = L.neighbor[k];
-          const Real r = std::sqrt(L.r2[k]);
-          const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
-          // Pressure (eq. 2.8) along r⃗ = x_i − x_j, and viscosity (eq. 2.10).
-          const Real fp = -m[j] * (pr[i] + pr[j]) * half / rho[j] * spiky.gradient_factor(r);
-          const Real fv = mu * m[j] / rho[j] * visc.laplacian(r);
-          fx += fp * dx + fv * (vx[j] - vx[i]);
-          fy += fp * dy + fv * (vy[j] - vy[i]);
-          fz += fp * dz + fv * (vz[j] - vz[i]);
+          // 1/r = 0 at r = 0 (coincident particles): no pressure force without a direction.
+          const Real r = std::sqrt(L.r2[k]), inv_r = r > Real(0) ? Real(1) / r : Real(0), q = laws.gap(r);
+          const Real vol_j = m[j] / rho[j];
+          const Real fp = laws.pressure.term(pr[i], vol_j, pr[j] * vol_j, q, inv_r);  // along r⃗ = x_i − x_j
+          const Real fv = laws.viscosity.term(vol_j, q);
+          px += fp * (x[i] - x[j]);
+          py += fp * (y[i] - y[j]);
+          pz += fp * (z[i] - z[j]);
+          qx += fv * (vx[j] - vx[i]);
+          qy += fv * (vy[j] - vy[i]);
+          qz += fv * (vz[j] - vz[i]);
         }
         const Real inv_rho = Real(1) / rho[i];
-        ax[i] += fx * inv_rho;
-        ay[i] += fy * inv_rho;
-        az[i] += fz * inv_rho;
+        ax[i] += laws.acceleration(px, qx, inv_rho);
+        ay[i] += laws.acceleration(py, qy, inv_rho);
+        az[i] += laws.acceleration(pz, qz, inv_rho);
       }
     });
   }
