@@ -51,17 +51,6 @@ double energy_growth(const fs::path& run) {
   return largest / (std::stod(rows[1][k]) + std::stod(rows[1][u]));
 }
 
-void expect_same_outputs(const fs::path& a, const fs::path& b) {
-  std::size_t compared = 0;
-  for (const auto& e : fs::directory_iterator(a)) {
-    const auto name = e.path().filename().string();
-    if (e.is_directory() || name == "scene.toml") continue;
-    ASSERT_TRUE(fs::exists(b / name)) << name;
-    EXPECT_TRUE(slurp(e.path()) == slurp(b / name)) << name << " differs";
-    ++compared;
-  }
-  EXPECT_GE(compared, 4u);
-}
 
 class Blowup : public Cli {};
 

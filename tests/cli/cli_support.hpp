@@ -25,6 +25,21 @@ inline std::string slurp(const fs::path& p) {
   return s.str();
 }
 
+// Every output file of two finished runs (frames, series, diagnostics),
+// compared byte for byte; the run folders' own bookkeeping (the lock with its
+// pid, the manifest with the run's identity) and the saved scene are not outputs.
+inline void expect_same_outputs(const fs::path& a, const fs::path& b) {
+  std::size_t compared = 0;
+  for (const auto& e : fs::directory_iterator(a)) {
+    const auto name = e.path().filename().string();
+    if (e.is_directory() || name == "scene.toml" || name == ".swirl.lock" || name == "manifest.txt") continue;
+    ASSERT_TRUE(fs::exists(b / name)) << name;
+    EXPECT_TRUE(slurp(e.path()) == slurp(b / name)) << name << " differs";
+    ++compared;
+  }
+  EXPECT_GE(compared, 4u);
+}
+
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {

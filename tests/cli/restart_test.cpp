@@ -18,18 +18,6 @@ const std::string kExamples = std::string(SWIRL_SOURCE_DIR) + "/examples/";
 const std::string kSph = kExamples + "dam_break.toml --set particles.0.spacing=0.03 --set output.interval=0.004";
 const std::string kGravity = kExamples + "plummer.toml --set particles.0.count=400 --set output.interval=0.125";
 
-// Every output file of a finished run (frames, series, diagnostics), compared byte for byte.
-void expect_same_outputs(const fs::path& a, const fs::path& b) {
-  std::size_t compared = 0;
-  for (const auto& e : fs::directory_iterator(a)) {
-    const auto name = e.path().filename().string();
-    if (e.is_directory() || name == "scene.toml") continue;
-    ASSERT_TRUE(fs::exists(b / name)) << name;
-    EXPECT_TRUE(slurp(e.path()) == slurp(b / name)) << name << " differs";
-    ++compared;
-  }
-  EXPECT_GE(compared, 4u);
-}
 
 class Restart : public Cli {};
 

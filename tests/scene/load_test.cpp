@@ -166,7 +166,7 @@ TEST_F(LoadFile, MissingFileIsAnErrorNamingTheFileAndTheReason) {
     (void)load_scene(path);
     FAIL() << "no error";
   } catch (const SceneError& e) {
-    EXPECT_EQ(std::string(e.what()), path.string() + ": cannot read: No such file or directory");
+    EXPECT_EQ(std::string(e.what()), path.string() + ": cannot open: No such file or directory");
   }
 }
 
@@ -175,7 +175,7 @@ TEST_F(LoadFile, DirectoryIsAnErrorNamingTheReason) {
     (void)load_scene(dir_);
     FAIL() << "no error";
   } catch (const SceneError& e) {
-    EXPECT_EQ(std::string(e.what()), dir_.string() + ": cannot read: Is a directory");
+    EXPECT_EQ(std::string(e.what()), dir_.string() + ": is a directory; swirl reads only regular files");
   }
 }
 

@@ -46,22 +46,6 @@
 
 namespace swirl::sph {
 
-// The grid path of sph_fluid.hpp still fills these (that file is being
-// restructured on another branch and this one leaves its grid path alone):
-// converted to SphLaws, the one set of constants, once per pass. Remove with
-// that path's next edit (it becomes `const SphLaws<Real> laws(params_);`).
-template <class Real>
-struct GridPassConstants {
-  Real h = 1, h2 = 1;
-  Real rest_density = 1000, c2 = 100, pressure_floor = 0;  // p = max(floor, c² (ρ − ρ0))
-  Real mu = 0, half = Real(0.5);                          // viscosity; ½ for eq. 2.8, 1 consistent
-
-  SphLaws<Real> laws() const {
-    return SphLaws<Real>(h, {rest_density, c2, pressure_floor}, mu,
-                         half == Real(1) ? PressureForm::Consistent : PressureForm::Thesis);
-  }
-};
-
 // Per-particle values the density pass leaves for the force pass (sorted
 // order): V_i = m_i / ρ_i and p_i V_i, so that a pair costs no division but 1/r.
 template <class Real>
@@ -168,12 +152,6 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
   }
 }
 
-template <class Real, bool Simd>
-std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
-                           const GridPassConstants<Real>& k, std::size_t block_size, GridScratch<Real>& scratch) {
-  return grid_density<Real, Simd>(grid, p, k.laws(), block_size, scratch);
-}
-
 // Adds the pressure and viscosity accelerations (densities, pressures and the
 // scratch from grid_density()): per pair PressureLaw::term · r⃗ and
 // ViscosityLaw::term · (v_j − v_i) summed, SphLaws::acceleration() once per
@@ -233,12 +211,6 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
       az[i] += law.acceleration(s.pz, s.vz, inv_rho);
     });
   });
-}
-
-template <class Real, bool Simd>
-void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const GridPassConstants<Real>& k,
-                 std::size_t block_size, const GridScratch<Real>& scratch) {
-  grid_forces<Real, Simd>(grid, p, k.laws(), block_size, scratch);
 }
 
 }  // namespace swirl::sph

@@ -224,15 +224,7 @@ class SphFluid final : public Solver<Real> {
     }
     used_grid_ = true;
     lists_ = {};
-    GridPassConstants<Real> k;
-    k.h = Real(params_.smoothing_length);
-    k.h2 = k.h * k.h;
-    k.rest_density = Real(params_.rest_density);
-    k.c2 = Real(params_.sound_speed * params_.sound_speed);
-    k.pressure_floor = params_.negative_pressure == NegativePressure::Zero ? Real(0)
-                                                                            : -std::numeric_limits<Real>::infinity();
-    k.mu = Real(params_.viscosity);
-    k.half = params_.pressure_form == PressureForm::Thesis ? Real(0.5) : Real(1);
+    const SphLaws<Real> k(params_);
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.density");
