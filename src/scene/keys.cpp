@@ -666,7 +666,7 @@ Scene scene_with_every_section() {
   Scene s;
   s.sph.emplace();
   s.nbody.emplace();
-  s.random_box.emplace();
+  s.random_box = Scene::RandomBox{};
   return s;
 }
 

@@ -409,7 +409,7 @@ void read_random_box(const Table& top, Scene& s) {
     top.fail("box", "min and max are derived from the random box (L³ = N·(4/3)π h³ / k); remove them");
   s.walls = true;
   box.read(spec_of("box.restitution"), "restitution", s);
-  s.random_box.emplace();
+  s.random_box = Scene::RandomBox{};
   t.read_scene_keys(s);
   top.read(spec_of("particles"), "particles", s);
   const Scene::RandomBox& rb = *s.random_box;

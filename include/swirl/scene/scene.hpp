@@ -117,7 +117,7 @@ struct Scene {
   std::size_t block_size = 1024;           // simulation.block_size: particles per work block, ≥ 1
 
   // Time-step control (docs/stability.md). dt = "adaptive" chooses every step
-  // from the conditions below (sim/step_limits.hpp); a fixed dt is checked
+  // from the conditions below (each solver's add_limits(), force/solver.hpp); a fixed dt is checked
   // against them after every step (the blow-up guard).
   bool adaptive_dt = false;                // simulation.dt = "adaptive"
   double dt_min = 0;                       // simulation.dt_min, s: adaptive floor; 0 = 1e-6 × the first step

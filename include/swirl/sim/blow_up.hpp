@@ -7,7 +7,7 @@
 //   LeftDomain    a particle ended a position update further outside the box
 //                 than the SPH kernel support h (a step that keeps the CFL
 //                 condition moves a particle less than h);
-//   TimeStep      a fixed Δt exceeds a time-step condition (sim/step_limits.hpp)
+//   TimeStep      a fixed Δt exceeds a time-step condition (a solver's add_limits())
 //                 of the state the next step starts from;
 //   StepCollapse  an adaptive Δt fell below its floor (dt_min).
 // Every message names the step, the time, a particle id, the offending
