@@ -17,15 +17,12 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
-#include "thread_waiting.hpp"
 #include "swirl/core/simd_dispatch.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/config.hpp"
 #include "swirl/scene/load.hpp"
 
 int main(int argc, char** argv) {
-  // Before the OpenMP runtime spins up any thread (apps/swirl/thread_waiting.hpp).
-  swirl::cli::adopt_thread_waiting(argv);
   // A file-size limit must make writes fail (and the run stop cleanly), not kill us.
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"swirl: particle simulation (SPH fluids, Barnes-Hut gravity)", "swirl"};
