@@ -74,6 +74,19 @@ TEST_F(Blowup, ATooLargeStepStopsNamingTheConditionAndKeepsFramesAndCheckpoints)
   EXPECT_EQ(resumed.status, 0) << resumed.err;
 }
 
+// Issue 17, finding 11: a state made non-finite by the first step stops as a
+// blow-up (exit 1, the particle named), for both neighbour searches, not as
+// bad input from the sort of the next force evaluation.
+TEST_F(Blowup, ANonFiniteFirstStepIsABlowUpForEitherSearch) {
+  for (const std::string search : {"grid", "hash"}) {
+    const auto r = swirl("run " + kDam + " --set sph.viscosity=1e30 --set 'sph.neighbour_search=\"" + search +
+                         "\"' --steps 5 --out " + (dir_ / search).string());
+    EXPECT_EQ(r.status, 1) << search << ": " << r.err;
+    EXPECT_NE(r.err.find("blow-up: particle id"), std::string::npos) << search << ": " << r.err;
+    EXPECT_NE(r.err.find("non-finite"), std::string::npos) << search << ": " << r.err;
+  }
+}
+
 TEST_F(Blowup, AParticleShotOutOfTheBoxIsReportedAsLeavingIt) {
   const auto scene = write_scene("shot.toml", R"([simulation]
 dt = 4e-4

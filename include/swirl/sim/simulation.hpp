@@ -279,10 +279,31 @@ class Simulation {
                                 });
     if (order_.active()) {
       ScopedPhase sort(timers_, "forces.sort");
+      // A position the drift made non-finite stops the sort; it is a blow-up
+      // of the state (exit 1, the particle named), not bad input.
+      if (const std::size_t bad = first_non_finite_position(); bad != kNoParticle) throw_non_finite(bad);
       order_.update(particles_, settings_.block_size);
     }
     const SolverContext<Real> ctx{t, settings_.block_size, &timers_, order_.active() ? &order_ : nullptr};
     for (auto& s : solvers_) s->add_acceleration(particles_, ctx);
+  }
+
+  // The first particle whose position is not finite (a block-order fold), or kNoParticle.
+  std::size_t first_non_finite_position() const {
+    return parallel::reduce_blocks_pinned(
+        "finite_positions", particles_.size(), settings_.block_size, kNoParticle,
+        [&](std::size_t b, std::size_t e) {
+          const Real *x = particles_.position.x.data(), *y = particles_.position.y.data(),
+                     *z = particles_.position.z.data();
+          Real poison = 0;
+#pragma omp simd reduction(+ : poison)
+          for (std::size_t i = b; i < e; ++i) poison += (x[i] + y[i] + z[i]) * Real(0);
+          if (poison == Real(0)) return kNoParticle;
+          for (std::size_t i = b; i < e; ++i)
+            if (!std::isfinite(x[i]) || !std::isfinite(y[i]) || !std::isfinite(z[i])) return i;
+          return kNoParticle;
+        },
+        [](std::size_t a, std::size_t b) { return std::min(a, b); });
   }
 
   void evaluate_limits() {
