@@ -50,9 +50,11 @@ class Cli : public ::testing::Test {
   }
   void TearDown() override { fs::remove_all(dir_); }
 
-  Result swirl(const std::string& args) {
+  // Runs the CLI with `args`; `prefix` goes before it on the shell line (an
+  // environment variable, `timeout 60 `).
+  Result swirl(const std::string& args, const std::string& prefix = "") {
     const auto out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = std::string(SWIRL_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
+    const std::string cmd = prefix + std::string(SWIRL_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
     Result r;
     const int raw = std::system(cmd.c_str());
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;

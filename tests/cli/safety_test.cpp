@@ -32,17 +32,7 @@ class Safety : public Cli {
  protected:
   // A command that must end by itself: a hang (the bug) fails as status 124
   // instead of stalling the test suite.
-  Result swirl_bounded(const std::string& args) { return swirl_prefixed("timeout 60 ", args); }
-  Result swirl_prefixed(const std::string& prefix, const std::string& args) {
-    const auto out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-    const std::string cmd = prefix + std::string(SWIRL_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
-    Result r;
-    const int raw = std::system(cmd.c_str());
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-  }
+  Result swirl_bounded(const std::string& args) { return swirl(args, "timeout 60 "); }
   std::string scene() { return write_scene("s.toml", kScene).string(); }
   // A usage error: status 2, the flag named, nothing run.
   void expect_refused(const std::string& args, const std::string& flag) {
@@ -87,7 +77,7 @@ TEST_F(Safety, Finding8_HugeThreadCountsAreCappedNotACrash) {
   expect_refused("render " + dir_.string() + " --threads 100000", "--threads");
   expect_refused("hash-stats " + scene() + " --threads 100000", "--threads");
   expect_refused("bench bh-table --quick --threads 1,100000", "--threads");
-  const auto r = swirl_prefixed("OMP_NUM_THREADS=100000 ", run);
+  const auto r = swirl(run, "OMP_NUM_THREADS=100000 ");
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("warning: OpenMP was asked for 100000 threads"), std::string::npos) << r.err;
 }

@@ -280,30 +280,25 @@ class Simulation {
     if (order_.active()) {
       ScopedPhase sort(timers_, "forces.sort");
       // A position the drift made non-finite stops the sort; it is a blow-up
-      // of the state (exit 1, the particle named), not bad input.
-      if (const std::size_t bad = first_non_finite_position(); bad != kNoParticle) throw_non_finite(bad);
-      order_.update(particles_, settings_.block_size);
+      // of the state (exit 1, the particle named), not bad input. The search
+      // for the particle runs only then: the sort's bounds pass already checks.
+      try {
+        order_.update(particles_, settings_.block_size);
+      } catch (const spatial::NonFinitePosition&) {
+        throw_non_finite(first_non_finite_position());
+      }
     }
     const SolverContext<Real> ctx{t, settings_.block_size, &timers_, order_.active() ? &order_ : nullptr};
     for (auto& s : solvers_) s->add_acceleration(particles_, ctx);
   }
 
-  // The first particle whose position is not finite (a block-order fold), or kNoParticle.
+  // The first particle whose position is not finite (the order found one).
   std::size_t first_non_finite_position() const {
-    return parallel::reduce_blocks_pinned(
-        "finite_positions", particles_.size(), settings_.block_size, kNoParticle,
-        [&](std::size_t b, std::size_t e) {
-          const Real *x = particles_.position.x.data(), *y = particles_.position.y.data(),
-                     *z = particles_.position.z.data();
-          Real poison = 0;
-#pragma omp simd reduction(+ : poison)
-          for (std::size_t i = b; i < e; ++i) poison += (x[i] + y[i] + z[i]) * Real(0);
-          if (poison == Real(0)) return kNoParticle;
-          for (std::size_t i = b; i < e; ++i)
-            if (!std::isfinite(x[i]) || !std::isfinite(y[i]) || !std::isfinite(z[i])) return i;
-          return kNoParticle;
-        },
-        [](std::size_t a, std::size_t b) { return std::min(a, b); });
+    for (std::size_t i = 0; i < particles_.size(); ++i)
+      if (!std::isfinite(particles_.position.x[i]) || !std::isfinite(particles_.position.y[i]) ||
+          !std::isfinite(particles_.position.z[i]))
+        return i;
+    return 0;
   }
 
   void evaluate_limits() {

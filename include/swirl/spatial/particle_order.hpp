@@ -61,6 +61,13 @@
 
 namespace swirl::spatial {
 
+// A particle position that is not finite: the order cannot place it. The
+// simulation turns it into its blow-up report (it names the particle).
+class NonFinitePosition : public std::runtime_error {
+ public:
+  NonFinitePosition() : std::runtime_error("particle order: a particle position is not finite") {}
+};
+
 // What a solver asks of the shared order.
 struct OrderRequest {
   bool sorted = false;     // particles sorted along the curve
@@ -117,7 +124,7 @@ class ParticleOrder {
     if (!active()) return false;
     if (p.size() > 0xffffffffu) throw std::invalid_argument("particle order: more than 2^32 - 1 particles");
     const bool skin = request_.keep_within > 0;
-    if (skin && valid_ && keys_.size() == p.size() && within_tolerance(p, block_size)) return false;
+    if (skin && valid_ && keys().size() == p.size() && within_tolerance(p, block_size)) return false;
     const std::size_t n = p.size();
     frame_ = make_frame(bounds_of(p, block_size, p.position.x.data(), p.position.y.data(), p.position.z.data()));
     raw_.resize(n);
@@ -140,8 +147,7 @@ class ParticleOrder {
       reorder_.apply(p, order, block_size);
       ++epoch_;
     }
-    const auto sorted = sorter_.keys();
-    keys_.assign(sorted.begin(), sorted.end());
+    keys_view_ = sorter_.keys();  // the sort's own buffer: no copy
     if (skin) remember(p, block_size);
     valid_ = true;
     ++sorts_;
@@ -159,14 +165,15 @@ class ParticleOrder {
     const Real *x = p.extra(ref, 0).data(), *y = p.extra(ref, 1).data(), *z = p.extra(ref, 2).data();
     const std::size_t n = p.size();
     frame_ = make_frame(bounds_of(p, block_size, x, y, z));
-    keys_.resize(n);
+    resumed_keys_.resize(n);
     const KeyFrame f = frame_;
     parallel::for_blocks_pinned("order_keys", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
-      for (std::size_t i = b; i < e; ++i) keys_[i] = key_of(f, double(x[i]), double(y[i]), double(z[i]));
+      for (std::size_t i = b; i < e; ++i) resumed_keys_[i] = key_of(f, double(x[i]), double(y[i]), double(z[i]));
     });
     // The reference positions of a checkpoint are in sorted order, unless the
     // file is not what it claims: then sort again on the next update().
-    valid_ = std::is_sorted(keys_.begin(), keys_.end());
+    keys_view_ = resumed_keys_;
+    valid_ = std::is_sorted(resumed_keys_.begin(), resumed_keys_.end());
   }
 
   // The particles changed count or order outside update() (a new particle, a
@@ -177,7 +184,7 @@ class ParticleOrder {
   }
 
   // After update(): the sorted keys, one per particle in storage order, and their frame.
-  std::span<const std::uint64_t> keys() const { return keys_; }
+  std::span<const std::uint64_t> keys() const { return keys_view_; }
   const KeyFrame& frame() const { return frame_; }
   bool valid() const { return valid_; }
   std::uint64_t epoch() const { return epoch_; }
@@ -185,8 +192,8 @@ class ParticleOrder {
   // True when a cell request could be honoured (the box spans at most 2^21 cells per axis).
   bool cells_fit() const { return cells_fit_; }
   std::size_t bytes() const {
-    return (keys_.capacity() + raw_.capacity()) * sizeof(std::uint64_t) + reorder_.bytes() +
-           keys_.size() * 2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
+    return (resumed_keys_.capacity() + raw_.capacity()) * sizeof(std::uint64_t) + reorder_.bytes() +
+           raw_.size() * 2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
   }
 
   // The key of a point in a frame (the far faces map to the last quantum, or cell).
@@ -245,13 +252,13 @@ class ParticleOrder {
           a[6] += b[6];
           return a;
         });
-    if (box[6] != 0) throw std::runtime_error("particle order: a particle position is not finite");
+    if (box[6] != 0) throw NonFinitePosition();
     Bounds out{};
     for (std::size_t a = 0; a < 3; ++a) {
       out.lo[a] = p.empty() ? 0.0 : box[a];
       out.hi[a] = p.empty() ? 0.0 : box[a + 3];
       if (!std::isfinite(out.lo[a]) || !std::isfinite(out.hi[a]))
-        throw std::runtime_error("particle order: a particle position is not finite");
+        throw NonFinitePosition();
     }
     return out;
   }
@@ -331,7 +338,8 @@ class ParticleOrder {
   std::uint64_t epoch_ = 0;
   std::uint64_t sorts_ = 0;
   AlignedVector<std::uint64_t> raw_;   // keys in the order before the sort
-  AlignedVector<std::uint64_t> keys_;  // sorted keys, aligned with storage
+  std::span<const std::uint64_t> keys_view_;  // sorted keys, aligned with storage: sorter_'s or resumed_keys_
+  AlignedVector<std::uint64_t> resumed_keys_;  // the keys resume() rebuilt from the reference positions
   parallel::RadixSort<std::uint64_t> sorter_;
   ParticleReorder<Real> reorder_;
 };
