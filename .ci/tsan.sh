@@ -96,8 +96,11 @@ if [ -n "$warnings" ]; then
   while IFS= read -r w; do echo "  $w"; done <<<"$warnings"
 fi
 for t in "${TARGETS[@]}"; do
-  ldd "$BUILD/tests/$t" | grep -q "libomp.so" || { echo "tsan: $t is not linked to libomp" >&2; exit 1; }
-  ! ldd "$BUILD/tests/$t" | grep -q "libgomp" || { echo "tsan: $t is linked to libgomp" >&2; exit 1; }
+  # Capture first: with pipefail, `ldd | grep -q` fails at random when grep
+  # exits on its first match and ldd then dies of SIGPIPE.
+  libs=$(ldd "$BUILD/tests/$t")
+  grep -q "libomp.so" <<<"$libs" || { echo "tsan: $t is not linked to libomp" >&2; exit 1; }
+  ! grep -q "libgomp" <<<"$libs" || { echo "tsan: $t is linked to libgomp" >&2; exit 1; }
 done
 
 # The run's environment: Archer (loaded by libomp through OMPT) turns OpenMP's
