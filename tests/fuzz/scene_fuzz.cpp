@@ -3,7 +3,7 @@
 // scenes. See scene_replay.hpp; run with .ci/fuzz.sh or
 //   build-fuzz/scene_fuzz -dict=tests/fuzz/scene.dict CORPUS_COPY tests/fuzz/corpus/scene
 // SWIRL_FUZZ_STRICT=1 also requires finite particles from every accepted scene.
-// fuzz-modules: scene gravity
+// fuzz-modules: scene gravity io
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
