@@ -19,9 +19,13 @@ void ProgressDisplay::update(const sim::RunProgress& p) {
   if (!done && p.wall_seconds - last_shown_ < every) return;
   last_shown_ = p.wall_seconds;
 
-  const double fraction = p.total_steps ? static_cast<double>(p.step) / static_cast<double>(p.total_steps) : 1.0;
-  const double rate = p.wall_seconds > 0 ? static_cast<double>(p.step) / p.wall_seconds : 0.0;
-  const double eta = rate > 0 ? static_cast<double>(p.total_steps - p.step) / rate : 0.0;
+  // Never past 100 %, and the rate and ETA of this invocation's steps (a
+  // resumed run starts at its checkpoint's step).
+  const double fraction =
+      p.total_steps ? std::min(1.0, static_cast<double>(p.step) / static_cast<double>(p.total_steps)) : 1.0;
+  const std::uint64_t taken = p.step - std::min(p.first_step, p.step), left = p.total_steps - std::min(p.step, p.total_steps);
+  const double rate = p.wall_seconds > 0 ? static_cast<double>(taken) / p.wall_seconds : 0.0;
+  const double eta = rate > 0 ? static_cast<double>(left) / rate : 0.0;
   const std::string stats = fmt::format("step {}/{}  t = {:.4g} s  {:.1f} steps/s  ETA {:.0f} s", p.step,
                                         p.total_steps, p.sim_time, rate, std::ceil(eta));
   if (terminal_) {

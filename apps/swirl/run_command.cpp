@@ -139,8 +139,12 @@ int run(const RunArgs& args) {
   progress.finish();
   for (const auto& w : summary.warnings) fmt::print(stderr, "swirl run: warning: {}\n", w);
 
+  const bool failed_checks = !summary.failed_checks.empty();
   fmt::print("{}\n{}",
-             summary.interrupted ? "swirl run: INTERRUPTED" : (summary.error.empty() ? "swirl run: done" : "swirl run: STOPPED"),
+             summary.interrupted       ? "swirl run: INTERRUPTED"
+             : !summary.error.empty()  ? "swirl run: STOPPED"
+             : failed_checks           ? "swirl run: FINISHED, BUT CHECKS FAILED"
+                                       : "swirl run: done",
              summary_text(summary));
   if (!args.summary_json.empty()) io::write_file_atomic(args.summary_json, summary_json(summary));
   if (summary.interrupted) {
@@ -153,6 +157,15 @@ int run(const RunArgs& args) {
                options.out_dir.string());
     if (!summary.last_checkpoint.empty())
       fmt::print(stderr, "swirl run: the last checkpoint is {}\n", summary.last_checkpoint.string());
+    return 1;
+  }
+  if (failed_checks) {
+    // --on-blowup=warn went on as asked; the results still failed checks, so
+    // the status must not say "done" to a script.
+    fmt::print(stderr, "swirl run: the run reached its end, but with --on-blowup=warn it went on past failed checks:\n");
+    for (const auto& line : summary.failed_checks) fmt::print(stderr, "swirl run:   {}\n", line);
+    fmt::print(stderr, "swirl run: the frames in {} show a state the checks rejected; exit status 1\n",
+               options.out_dir.string());
     return 1;
   }
   return 0;

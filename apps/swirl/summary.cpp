@@ -52,7 +52,8 @@ std::string summary_text(const sim::RunSummary& s) {
 }
 
 std::string summary_json(const sim::RunSummary& s) {
-  std::string phases, metrics;
+  std::string phases, metrics, failed;
+  for (const auto& line : s.failed_checks) failed += fmt::format("{}{}", failed.empty() ? "" : ", ", json_string(line));
   for (const auto& [name, value] : s.metrics) metrics += fmt::format("  {}: {:.9g},\n", json_string(name), value);
   for (const auto& [name, seconds] : s.phases)
     phases += fmt::format("{}{}: {:.9g}", phases.empty() ? "" : ", ", json_string(name), seconds);
@@ -61,11 +62,11 @@ std::string summary_json(const sim::RunSummary& s) {
       "  \"scene\": {},\n  \"precision\": {},\n  \"out_dir\": {},\n  \"threads\": {},\n  \"simd\": \"{}\",\n"
       "  \"particles\": {},\n  \"steps\": {},\n  \"sim_time\": {:.17g},\n  \"wall_seconds\": {:.9g},\n"
       "  \"steps_per_second\": {:.9g},\n  \"phase_seconds\": {{{}}},\n  \"bytes_per_particle\": {},\n"
-      "  \"frames\": {},\n{}  \"completed\": {},\n  \"error\": {}\n}}\n",
+      "  \"frames\": {},\n{}  \"completed\": {},\n  \"failed_checks\": [{}],\n  \"error\": {}\n}}\n",
       json_string(s.scene_file), json_string(s.precision), json_string(s.out_dir.string()), s.threads,
       simd::isa_name(simd::active()), s.particles,
       s.steps, s.sim_time, s.wall_seconds, s.steps_per_second, phases, s.bytes_per_particle, s.frames, metrics,
-      s.error.empty() ? "true" : "false", s.error.empty() ? "null" : json_string(s.error));
+      s.error.empty() ? "true" : "false", failed, s.error.empty() ? "null" : json_string(s.error));
 }
 
 }  // namespace swirl::cli

@@ -270,6 +270,12 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "simulation.eta", .section = "simulation", .range = Range{0, 10, true, false},
                      .doc = "η, gravity Δt ≤ η·sqrt(ε / \\|a\\|max) (ε = 0: the mean particle spacing in place of ε)"},
             in_scene(&Scene::eta)));
+  add(field(SceneKey{.key = "simulation.max_energy_error", .section = "simulation", .range = kNonNegative,
+                     .doc = "a run whose forces and walls all conserve energy stops (a blow-up) when its relative "
+                            "energy error \\|E − E0\\|/\\|E0\\| at an output time exceeds this (0 = never)",
+                     // A guard, not physics: the trajectory and so the checkpoints' scene hash do not depend on it.
+                     .hashed = false},
+            in_scene(&Scene::max_energy_error)));
 
   // [box]: the walls. A random box derives min and max itself.
   const auto box_corner = [](Vec3d Box<double>::*corner) {

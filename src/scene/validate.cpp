@@ -1,5 +1,6 @@
 #include "swirl/scene/validate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -7,6 +8,7 @@
 
 #include "messages.hpp"
 #include "sources.hpp"
+#include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/keys.hpp"
 
 namespace swirl::scene {
@@ -67,6 +69,15 @@ class Checker {
            "the paper's tree uses the paper's rule only (use tree = \"linear\" with scheme = \"global\")");
     if (g.walk != gravity::Walk::particle)
       fail("nbody.walk", "the paper's tree walks per particle only (use tree = \"linear\" with scheme = \"global\")");
+  }
+
+  void sph() const {
+    const double keys = dense_cell_table_keys(s_);
+    if (keys > 0x1p31)
+      fail("sph.grid.table",
+           fmt::format("a dense cell table over the box with cells of h + skin = {:g} would need {:.3g} entries, more "
+                       "than 2^31; use \"auto\" or \"hashed\", or a larger smoothing length",
+                       s_.sph->smoothing_length + s_.sph->grid_skin, keys));
   }
 
   void sources() const {
@@ -172,7 +183,37 @@ void validate(const Scene& scene) {
   check.units();
   check.box();
   check.nbody();
+  check.sph();
   check.sources();
+}
+
+double dense_cell_table_keys(const Scene& scene) {
+  if (!scene.sph || !scene.walls || scene.sph->neighbour_search != sph::NeighbourSearch::Grid ||
+      scene.sph->cell_table != spatial::CellTable::Dense)
+    return 0;
+  const double cell = scene.sph->smoothing_length + scene.sph->grid_skin;
+  double keys = 1;
+  for (int axis = 0; axis < 3; ++axis) {
+    const double cells = std::max(1.0, std::ceil((scene.box.hi[axis] - scene.box.lo[axis]) / cell));
+    keys *= scene.sph->cell_order == spatial::CellOrder::Morton ? std::exp2(std::ceil(std::log2(cells))) : cells;
+  }
+  return keys;
+}
+
+std::vector<std::string> advisories(const Scene& scene) {
+  std::vector<std::string> out;
+  const std::string file = scene.file.empty() ? std::string("scene") : scene.file;
+  if (scene.nbody && scene.nbody->softening == 0 && count_particles(scene) > 1)
+    out.push_back(file + ": nbody.softening = 0: the force between two particles grows without bound as they "
+                         "approach (1/r²), so one close pair can ruin the energy of the whole run; give a softening of "
+                         "a few percent of the mean particle spacing, or keep 0 only for a few well-separated bodies "
+                         "(" +
+                  (scene.max_energy_error > 0
+                       ? fmt::format("the run stops if its relative energy error passes simulation.max_energy_error = {:g}",
+                                     scene.max_energy_error)
+                       : std::string("simulation.max_energy_error = 0: nothing stops a run whose energy is ruined")) +
+                  ")");
+  return out;
 }
 
 }  // namespace swirl::scene

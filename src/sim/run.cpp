@@ -19,6 +19,7 @@
 #include "swirl/io/vtp.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
+#include "swirl/scene/validate.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/observer.hpp"
 
@@ -115,9 +116,12 @@ class DiagnosticsLog final : public Observer<Real> {
   DiagnosticsLog(const scene::Scene& scene, const RunOptions& options, const Simulation<Real>& sim,
                  io::RunFolder& folder)
       : path_(options.out_dir / "diagnostics.csv"), schedule_(scene.output_interval, scene.dt),
-        adaptive_(scene.adaptive_dt), dt_max_(scene.dt), block_size_(scene.block_size), folder_(folder) {
+        adaptive_(scene.adaptive_dt), dt_max_(scene.dt), block_size_(scene.block_size),
+        max_energy_error_(scene.max_energy_error), folder_(folder) {
+    // Walls that keep less than all of the normal speed take energy out.
     conservative_ = std::all_of(sim.solvers().begin(), sim.solvers().end(),
-                                [](const auto& s) { return s->conserves_energy(); });
+                                [](const auto& s) { return s->conserves_energy(); }) &&
+                    (!scene.walls || scene.restitution == 1);
     std::string header = "time,kinetic_energy,potential_energy,total_energy";
     if (conservative_) header += ",relative_energy_error";
     header += ",momentum_x,momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z";
@@ -199,6 +203,13 @@ class DiagnosticsLog final : public Observer<Real> {
     io::write_file_atomic(folder_.claim(path_), text_);
     ++rows_;
     last_step_ = sim.step_count();
+    // Checked once the row is written: the log shows the error that stopped the run.
+    if (conservative_ && max_energy_error_ > 0 && !(std::abs(energy_error_) <= max_energy_error_))
+      sim.fail_check(BlowUpCause::EnergyDrift,
+                     fmt::format("the relative energy error is {:.3g} (E = {:.6g}, E0 = {:.6g}), beyond "
+                                 "simulation.max_energy_error = {:.3g}: the forces or the steps no longer resolve the "
+                                 "motion (a close encounter, or a step too long)",
+                                 energy_error_, total, initial_energy_, max_energy_error_));
   }
 
   // What sets the next adaptive step: a condition, dt_max, or the growth cap.
@@ -242,6 +253,7 @@ class DiagnosticsLog final : public Observer<Real> {
   bool adaptive_;
   double dt_max_;
   std::size_t block_size_;
+  double max_energy_error_;
   io::RunFolder& folder_;
   bool conservative_ = true;
   std::string text_;
@@ -345,16 +357,21 @@ class GuardReporter final : public Observer<Real> {
       on_warning_(n == 1 ? event.message : fmt::format("({} times so far) {}", n, event.message));
     }
   }
-  void add_warnings(std::vector<std::string>& out) const {
+  // The diagnostics' last row (its energy check) comes after the last step.
+  void on_finish(Simulation<Real>& sim) override { on_step(sim); }
+  // One line per kind of check that failed.
+  std::vector<std::string> failed_checks() const {
+    std::vector<std::string> out;
     for (std::size_t k = 0; k < counts_.size(); ++k)
       if (counts_[k] > 0)
-        out.push_back(fmt::format("{} steps failed the '{}' check (--on-blowup=warn)", counts_[k],
+        out.push_back(fmt::format("{} {} failed the '{}' check", counts_[k], counts_[k] == 1 ? "step" : "steps",
                                   to_string(static_cast<BlowUpCause>(k))));
+    return out;
   }
 
  private:
   std::function<void(const std::string&)> on_warning_;
-  std::array<std::uint64_t, 4> counts_{};
+  std::array<std::uint64_t, kBlowUpCauses> counts_{};
 };
 
 // ---------------------------------------------------------------------------
@@ -367,7 +384,10 @@ class Progress final : public Observer<Real> {
   Progress(Callback callback, Total total) : callback_(std::move(callback)), total_(std::move(total)) {}
   std::string_view name() const override { return "progress"; }
   // The wall clock runs from construction: before start() and frame 0, as the phase timers do.
-  void on_start(Simulation<Real>& sim, bool) override { report(sim); }
+  void on_start(Simulation<Real>& sim, bool) override {
+    first_step_ = sim.step_count();
+    report(sim);
+  }
   void on_step(Simulation<Real>& sim) override {
     dt_min_ = std::min(dt_min_, sim.last_dt());
     dt_max_ = std::max(dt_max_, sim.last_dt());
@@ -379,11 +399,12 @@ class Progress final : public Observer<Real> {
 
  private:
   void report(const Simulation<Real>& sim) const {
-    if (callback_) callback_({sim.step_count(), total_(), sim.time(), wall()});
+    if (callback_) callback_({sim.step_count(), first_step_, total_(), sim.time(), wall()});
   }
   Callback callback_;
   Total total_;
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
+  std::uint64_t first_step_ = 0;
   double dt_min_ = std::numeric_limits<double>::infinity(), dt_max_ = 0;
 };
 
@@ -403,6 +424,64 @@ std::size_t bytes_per_particle(const Simulation<Real>& sim) {
 std::uint64_t steps_until(double t, double dt) {
   return static_cast<std::uint64_t>(std::max(0.0, std::ceil(t / dt - 1e-9)));
 }
+
+// Where a run ends: a step count, or (adaptive steps) a time landed on
+// exactly. Checkpoints carry it ("run.end_step" / "run.end_time"), so a
+// resume without --steps or --until ends where the first invocation would
+// have (its --steps or --until included).
+struct RunEnd {
+  bool to_time = false;
+  std::uint64_t step = 0;  // !to_time
+  double time = 0;         // to_time
+
+  // The largest step a run counts (time = step·dt stays exact in a double).
+  static constexpr std::uint64_t kMaxStep = std::uint64_t{1} << 53;
+
+  // From the flags (--steps: that many more from `from_step`), else what the
+  // checkpoint remembers, else the scene.
+  static RunEnd choose(const scene::Scene& scene, const RunOptions& options, std::uint64_t from_step, double from_time,
+                       const NamedValues* saved) {
+    RunEnd e;
+    if (options.steps) {
+      if (*options.steps > kMaxStep - std::min(from_step, kMaxStep))
+        throw std::invalid_argument(fmt::format("--steps {}: from step {} that passes the 2^53 steps a run can count",
+                                                *options.steps, from_step));
+      e.step = from_step + *options.steps;
+      return e;
+    }
+    if (options.until) {
+      if (!(*options.until > from_time))
+        throw std::invalid_argument(fmt::format("--until {}: the run is already at t = {:.6g}; give a later time",
+                                                *options.until, from_time));
+      return at_time(scene, *options.until);
+    }
+    if (saved) {
+      if (const auto step = find_value(*saved, "run.end_step")) {
+        e.step = static_cast<std::uint64_t>(*step);
+        return e;
+      }
+      if (const auto time = find_value(*saved, "run.end_time")) return at_time(scene, *time);
+    }
+    if (scene.adaptive_dt && scene.end_time) return at_time(scene, *scene.end_time);
+    e.step = scene.total_steps();
+    return e;
+  }
+  static RunEnd at_time(const scene::Scene& scene, double t) {
+    RunEnd e;
+    if (scene.adaptive_dt) {
+      e.to_time = true, e.time = t;
+    } else {
+      e.step = steps_until(t, scene.dt);
+    }
+    return e;
+  }
+  void save(NamedValues& out) const {
+    out.emplace_back(to_time ? "run.end_time" : "run.end_step", to_time ? time : double(step));
+  }
+  std::string describe() const {
+    return to_time ? fmt::format("t = {:.6g}", time) : fmt::format("step {}", step);
+  }
+};
 
 // Reads the newest valid checkpoint of this scene into sim and returns its
 // header and values; warnings name the files skipped.
@@ -447,19 +526,22 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
                        : options.overwrite ? io::RunFolderMode::Overwrite
                                            : io::RunFolderMode::Fresh,
                        fmt::format("{} {:016x}", scene.file, hash));
+  // Valid but likely to hurt (zero softening): said before the first step.
+  for (const std::string& w : scene::advisories(scene)) {
+    if (options.on_warning) options.on_warning(w);
+    else summary.warnings.push_back(w);
+  }
   sim.set_on_blow_up(options.on_blow_up);
   sim.prepare();  // every field declared, so a checkpoint's fields meet their uses
   summary.particles = sim.particles().size();
 
-  // Where the run ends: a step count, or (adaptive steps) a time landed on exactly.
-  std::uint64_t target = scene.total_steps();
+  // Where the run ends (RunEnd): decided once the clock is known (below).
   const bool adaptive = scene.adaptive_dt;
-  const bool to_time = adaptive && !options.steps && (options.until || scene.end_time);
-  const double end_time = to_time ? options.until.value_or(scene.end_time.value_or(0.0)) : 0.0;
+  RunEnd end;
   auto total_steps = [&]() -> std::uint64_t {
-    if (!to_time) return target;
+    if (!end.to_time) return std::max(end.step, sim.step_count());
     // An estimate: the steps still to go at the current step size.
-    const double left = std::max(0.0, (end_time - sim.time()) / sim.proposed_dt());
+    const double left = std::max(0.0, (end.time - sim.time()) / sim.proposed_dt());
     return sim.step_count() + static_cast<std::uint64_t>(std::min(std::ceil(left), 1e18));
   };
 
@@ -470,6 +552,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps);
   std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get(), guard.get()};
   auto collect = [&](NamedValues& values) {
+    end.save(values);
     save_clock(sim.clock(), values);
     sim.save_state(values);
     for (const Observer<Real>* o : observers) o->save_state(values);
@@ -485,13 +568,18 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     sim.resume(clock, values);
     for (Observer<Real>* o : observers) o->load_state(values);
     summary.first_step = header.step;
+    end = RunEnd::choose(scene, options, header.step, header.time, &values);
+    if (!(end.to_time ? sim.time() < end.time : sim.step_count() < end.step))
+      throw std::invalid_argument(fmt::format(
+          "--resume {}: the run already reached the end it was given ({}; its newest checkpoint is at step {}, "
+          "t = {:.6g}); to go further give --steps N (N more steps) or --until T (a later time)",
+          options.out_dir.string(), end.describe(), sim.step_count(), sim.time()));
   } else {
+    end = RunEnd::choose(scene, options, 0, 0.0, nullptr);
     io::write_file_atomic(folder.claim(options.out_dir / "scene.toml"),
                           scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
   }
-  if (options.until) target = steps_until(*options.until, scene.dt);
-  if (options.steps) target = summary.first_step + *options.steps;
-  auto running = [&] { return to_time ? sim.time() < end_time : sim.step_count() < target; };
+  auto running = [&] { return end.to_time ? sim.time() < end.time : sim.step_count() < end.step; };
 
   try {
     if (!options.resume) sim.start();  // solvers fill their fields (density, potential) here
@@ -500,7 +588,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     while (running()) {
       std::optional<double> land;
       if (adaptive) {  // land exactly on the end time and on the observers' next times
-        if (to_time) land = end_time;
+        if (end.to_time) land = end.time;
         for (const Observer<Real>* o : observers)
           if (const auto t = o->next_time(sim); t && (!land || *t < *land)) land = t;
       }
@@ -523,7 +611,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
   }
 
-  guard->add_warnings(summary.warnings);
+  summary.failed_checks = guard->failed_checks();
   if (!checkpoints->last().empty()) summary.last_checkpoint = checkpoints->last();
   summary.steps = sim.step_count() - summary.first_step;
   summary.sim_time = sim.time();
@@ -547,16 +635,39 @@ struct Footprint {
   double frame = 0;   // bytes of one .vtp frame
 };
 
+// Every size a scene sets is in it: the particle count, the neighbours its
+// smoothing length gives, the hash table's buckets, a dense cell table's cells.
 Footprint footprint(const scene::Scene& scene) {
   const double n = static_cast<double>(scene::count_particles(scene));
   const double real = scene.precision == scene::Precision::Float ? 4 : 8;
-  // 16 reals and an id of fields; the scene's double copy while building; SPH
-  // hash, sorted copies and ~40 neighbours of (index, r²) twice (block lists
-  // and the CSR); tree nodes for gravity.
+  // 16 reals and an id of fields; the scene's double copy while building; tree
+  // nodes for gravity.
   double per_particle = 16 * real + 8 + 56;
-  if (scene.sph) per_particle += 40 + 2 * 40 * (4 + real);
   if (scene.nbody) per_particle += 2 * 96;
-  return {n * per_particle, n * (16 * real + 8 + 16) + 4096};
+  double fixed = 0;
+  if (scene.sph) {
+    const sph::SphParameters& sph = *scene.sph;
+    const double h = sph.smoothing_length;
+    // Neighbours: ~40 at the usual k, more when h is large against the
+    // spacing (from the box's mean density: fluid fills part of it, so at least 40).
+    double neighbours = 40;
+    if (scene.walls) {
+      const Vec3d size = scene.box.hi - scene.box.lo;
+      const double volume = size.x * size.y * size.z;
+      if (volume > 0) neighbours = std::max(neighbours, std::min(n, 4.18879 * h * h * h * n / volume));
+    }
+    // Sorted copies, and (index, r²) per neighbour twice (block lists and the CSR).
+    per_particle += 40 + 2 * neighbours * (4 + real);
+    if (sph.neighbour_search == sph::NeighbourSearch::Hash) {
+      // The counting sort's offsets and one count per bucket for each chunk (thread).
+      const double buckets = sph.buckets ? double(sph.buckets) : 1.6 * n + 1;
+      const double chunks = std::min(double(parallel::thread_count()), std::floor(n / 4096) + 1);
+      fixed += 4 * buckets * (1 + chunks);
+    } else {
+      fixed += 4 * scene::dense_cell_table_keys(scene);  // one start per cell key
+    }
+  }
+  return {n * per_particle + fixed, n * (16 * real + 8 + 16) + 4096};
 }
 
 std::uint64_t memory_available() {
@@ -571,7 +682,8 @@ void check_memory(const scene::Scene& scene) {
   const std::uint64_t available = memory_available();
   if (available > 0 && f.memory > 0.9 * static_cast<double>(available))
     throw std::invalid_argument(fmt::format(
-        "{}: {} particles need about {:.1f} GB of memory, more than the {:.1f} GB this machine has free",
+        "{}: {} particles need about {:.1f} GB of memory, more than the {:.1f} GB this machine has free (counted: "
+        "the particle fields, the neighbour lists the smoothing length gives, sph.hash.buckets, a dense sph.grid.table)",
         scene.file, scene::count_particles(scene), f.memory / 1e9, static_cast<double>(available) / 1e9));
 }
 

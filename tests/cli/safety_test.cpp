@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,186 @@ TEST_F(Safety, Finding5_StepCountsThatOverflowAreRefused) {
   // The largest count is still accepted: --until's bound is the step count, not T.
   const auto r = swirl(run + " --until 0.05");
   EXPECT_EQ(r.status, 0) << r.err;
+}
+
+// Finding 4: zero softening and a close pair: a warning before the first
+// step, then the energy-error guard stops the run (exit 1) with the error
+// logged; the threshold is a scene key (0 turns the check off).
+TEST_F(Safety, Finding4_AnEnergyErrorPastTheLimitStopsTheRun) {
+  const auto scene = write_scene("close.toml", R"([simulation]
+dt = 0.001
+end_time = 0.05
+[nbody]
+softening = 0.0
+opening = 0.0
+[output]
+interval = 0.01
+[[particles]]
+kind = "list"
+positions = [[0.0, 0.0, 0.0], [1e-6, 0.0, 0.0], [1.0, 0.0, 0.0]]
+velocities = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
+mass = 1.0
+)");
+  const auto r = swirl("run " + scene.string() + " --out " + (dir_ / "a").string());
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("warning: " + scene.string() + ": nbody.softening = 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("blow-up: the relative energy error is"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("simulation.max_energy_error = 0.1"), std::string::npos) << r.err;
+  EXPECT_NE(r.out.find("swirl run: STOPPED"), std::string::npos) << r.out;
+  const auto rows = csv_rows(dir_ / "a" / "diagnostics.csv");
+  ASSERT_GE(rows.size(), 3u);  // header, t = 0, the row that failed
+  EXPECT_GT(std::abs(std::stod(rows.back()[column(rows[0], "relative_energy_error")])), 0.1);
+  // Turned off, the same run ends "done" (the warning stays).
+  const auto off = swirl("run " + scene.string() + " --set simulation.max_energy_error=0 --out " + (dir_ / "b").string());
+  EXPECT_EQ(off.status, 0) << off.err;
+  EXPECT_NE(off.err.find("nothing stops a run whose energy is ruined"), std::string::npos) << off.err;
+  // With softening: no warning, and the run conserves energy well within the limit.
+  const auto soft = swirl("run " + scene.string() + " --set nbody.softening=0.05 --out " + (dir_ / "c").string());
+  EXPECT_EQ(soft.status, 0) << soft.err;
+  EXPECT_EQ(soft.err.find("warning"), std::string::npos) << soft.err;
+  // Walls that take energy out: no energy check (and no column) at all.
+  const auto walls = swirl("run " + scene.string() + " --set simulation.max_energy_error=1e-12 --out " +
+                           (dir_ / "d").string() + " --set 'box.min=[-2.0,-2.0,-2.0]' --set 'box.max=[2.0,2.0,2.0]'" +
+                           " --set box.restitution=0.5 --set nbody.softening=0.05");
+  EXPECT_EQ(walls.status, 0) << walls.err;
+  EXPECT_EQ(slurp(dir_ / "d" / "diagnostics.csv").find("relative_energy_error"), std::string::npos);
+}
+
+// Finding 5, on resume: --steps counts from the checkpoint, and a count that
+// passes 2^53 from there, or an --until already passed, is refused.
+TEST_F(Safety, Finding5_ResumeRefusesStepCountsItCannotHonour) {
+  const auto run = dir_ / "run";
+  ASSERT_EQ(swirl("run " + scene() + " --out " + run.string() + " --steps 10 --checkpoint-every-steps 5").status, 0);
+  const std::string resume = "run --resume " + run.string();
+  expect_refused(resume + " --steps 9007199254740990", "--steps 9007199254740990: from step 10");
+  expect_refused(resume + " --until 0.05", "--until 0.05: the run is already at t = 0.1");
+  const auto r = swirl(resume + " --steps 3");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("steps            3 (t = 0.13"), std::string::npos) << r.out;
+}
+
+// Finding 6: the run folder remembers where the run ends (--steps, --until),
+// so the resume hint needs no flags; a run already at its end is refused
+// (nothing run, no extra frame); progress never passes 100 %.
+TEST_F(Safety, Finding6_AResumeEndsWhereTheRunWasToldToEnd) {
+  const auto run = dir_ / "run";
+  ASSERT_EQ(swirl("run " + scene() + " --out " + run.string() + " --steps 20 --checkpoint-every-steps 5 --checkpoint-keep 4")
+                .status,
+            0);
+  const auto frames = swirl::io::read_pvd(run / "particles.pvd").size();
+  // Nothing left to do: refused, nothing written.
+  auto r = swirl("run --resume " + run.string());
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("the run already reached the end it was given (step 20"), std::string::npos) << r.err;
+  EXPECT_EQ(swirl::io::read_pvd(run / "particles.pvd").size(), frames);
+  // As after a stop at step 10: the resume goes to step 20 (the scene's end is step 24).
+  fs::remove(run / "checkpoints" / "checkpoint_000000000020.swc");
+  fs::remove(run / "checkpoints" / "checkpoint_000000000015.swc");
+  r = swirl("run --resume " + run.string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("steps            10 (t = 0.2"), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("progress 1000%"), std::string::npos);
+  for (auto at = r.err.find("progress"); at != std::string::npos; at = r.err.find("progress", at + 1)) {
+    const int percent = std::stoi(r.err.substr(at + 8, 5));
+    EXPECT_LE(percent, 100) << r.err;
+  }
+  EXPECT_NE(r.err.find("step 20/20"), std::string::npos) << r.err;
+  // --until is remembered too (time 0.15 = step 15).
+  const auto timed = dir_ / "timed";
+  ASSERT_EQ(swirl("run " + scene() + " --out " + timed.string() + " --until 0.15 --checkpoint-every-steps 5 --checkpoint-keep 4")
+                .status,
+            0);
+  fs::remove(timed / "checkpoints" / "checkpoint_000000000015.swc");
+  r = swirl("run --resume " + timed.string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("steps            5 (t = 0.15"), std::string::npos) << r.out;
+}
+
+// Finding 7: --on-blowup=warn goes on, but a run that went past failed checks
+// ends with status 1 and a summary of what failed (also in --summary-json).
+TEST_F(Safety, Finding7_WarnGoesOnButEndsWithStatus1AndWhatFailed) {
+  const std::string dam = std::string(SWIRL_SOURCE_DIR) + "/examples/dam_break.toml";
+  const auto json = dir_ / "summary.json";
+  const auto r = swirl("run " + dam + " --set simulation.dt=5e-3 --set simulation.end_time=0.02 --on-blowup=warn --out " +
+                       (dir_ / "a").string() + " --summary-json " + json.string());
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.out.find("swirl run: FINISHED, BUT CHECKS FAILED"), std::string::npos) << r.out;
+  EXPECT_NE(r.err.find("went on past failed checks"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("4 steps failed the 'time-step condition' check"), std::string::npos) << r.err;
+  const std::string summary = slurp(json);
+  const auto list = summary.find("\"failed_checks\": [\"");
+  ASSERT_NE(list, std::string::npos) << summary;
+  EXPECT_LT(list, summary.find("4 steps failed the 'time-step condition' check")) << summary;
+}
+
+// Finding 7, the gravity half: forces that are not finite in the initial state
+// (two particles 1e-155 apart, no softening: r³ underflows) stop before frame 0 is written,
+// and the message does not blame the time step.
+TEST_F(Safety, Finding7_InitialForcesThatAreNotFiniteStopBeforeFrame0) {
+  const auto scene = write_scene("same.toml", R"([simulation]
+dt = 0.001
+steps = 5
+[nbody]
+softening = 0.0
+[[particles]]
+kind = "list"
+positions = [[0.0, 0.0, 0.0], [1e-155, 0.0, 0.0], [1.0, 0.0, 0.0]]
+velocities = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
+mass = 1.0
+)");
+  const auto r = swirl("run " + scene.string() + " --out " + (dir_ / "a").string());
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("before the first step: blow-up: the forces of the initial state are not finite"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("time step"), r.err.find("no time step is involved") + 3) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "a" / "particles_000000.vtp"));
+}
+
+// Finding 9: the sizes a scene sets (hash buckets, a smoothing length that
+// makes every particle a neighbour, a dense cell table) are in the memory
+// estimate or the validation: refused at once with status 2, not minutes of
+// allocation, and before the run's folder is made.
+TEST_F(Safety, Finding9_EverySizeASceneSetsIsInTheMemoryEstimate) {
+  const auto scene = write_scene("sph.toml", R"([simulation]
+dt = 1e-4
+steps = 1
+[box]
+min = [0.0, 0.0, 0.0]
+max = [1.0, 1.0, 1.0]
+[sph]
+smoothing_length = 0.05
+[[particles]]
+kind = "fluid_block"
+min = [0.0, 0.0, 0.0]
+max = [0.5, 0.5, 0.5]
+spacing = 0.02
+)");
+  ASSERT_EQ(swirl("run " + scene.string() + " --out " + (dir_ / "fits").string()).status, 0);
+  const std::string run = "run " + scene.string() + " --out " + (dir_ / "o").string();
+  for (const std::string set : {"--set 'sph.neighbour_search=\"hash\"' --set sph.hash.buckets=4000000000",
+                                 // h = 5 over 125000 particles: every particle a neighbour of every other.
+                                 "--set sph.smoothing_length=5 --set particles.0.spacing=0.01"}) {
+    const auto r = swirl_bounded(run + " " + set);
+    EXPECT_EQ(r.status, 2) << set << "\n" << r.err;
+    EXPECT_NE(r.err.find("GB of memory"), std::string::npos) << set << "\n" << r.err;
+  }
+  // A dense cell table past 2^31 entries is a scene error, before the folder is made.
+  const auto r = swirl(run + " --set 'sph.grid.table=\"dense\"' --set sph.smoothing_length=1e-4");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("sph.grid.table: a dense cell table over the box"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o"));
+}
+
+// Finding 14: a particle thrown out of the box by a huge force (speed 0, the
+// displacement from ½·a·dt²) is reported with what moved it, and no "at most 0".
+TEST_F(Safety, Finding14_TheLeftTheBoxMessageNamesWhatMovedTheParticle) {
+  const std::string dam = std::string(SWIRL_SOURCE_DIR) + "/examples/dam_break.toml";
+  const auto r = swirl("run " + dam + " --set sph.sound_speed=1e12 --steps 3 --out " + (dir_ / "o").string());
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("left the box"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("speed 0, acceleration"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("|v|·dt = 0"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("at most 0)"), std::string::npos) << r.err;
 }
 
 // Finding 8: a thread count OpenMP cannot start is refused (flags) or lowered

@@ -96,9 +96,29 @@ TYPED_TEST(GuardTest, ANaNStopsTheRunEvenWhenWarningOnly) {
   auto settings = boxed(0.01);
   settings.on_blow_up = OnBlowUp::Warn;
   Simulation<Real> sim(particles<Real>(20), settings);
-  sim.add_solver(std::make_unique<Poison<Real>>(3, 0.0));
+  sim.add_solver(std::make_unique<Poison<Real>>(3, 0.005));  // from the first step's forces on
   sim.start();
   EXPECT_EQ(error_of(sim, 3).second, BlowUpCause::NonFinite);
+}
+
+// Forces of the initial state that are not finite stop start() itself: no
+// step exists to blame, and the message says so.
+TYPED_TEST(GuardTest, ANaNInTheInitialForcesStopsStartWithoutBlamingTheStep) {
+  using Real = TypeParam;
+  Simulation<Real> sim(particles<Real>(20), boxed(0.01));
+  sim.add_solver(std::make_unique<Poison<Real>>(3, 0.0));
+  try {
+    sim.start();
+    FAIL() << "no error";
+  } catch (const swirl::SimulationError& e) {
+    const std::string what = e.what();
+    EXPECT_EQ(e.cause(), BlowUpCause::NonFinite);
+    EXPECT_NE(what.find("before the first step: blow-up: the forces of the initial state are not finite: particle id 103 "
+                        "has a non-finite density"),
+              std::string::npos)
+        << what;
+    EXPECT_NE(what.find("no time step is involved"), std::string::npos) << what;
+  }
 }
 
 // A spring pulls every particle to the centre; with SPH limits the fastest

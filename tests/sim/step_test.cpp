@@ -205,12 +205,11 @@ TYPED_TEST(StepTest, ABlowUpStopsWithAMessageNamingTheParticle) {
   SimulationSettings settings;
   settings.dt = 0.1;
   Simulation<Real> sim(std::move(p), settings);
-  sim.start();
   try {
-    sim.step();
+    sim.start();  // the initial state is already broken: start() refuses it
     FAIL() << "no error";
   } catch (const swirl::SimulationError& e) {
-    EXPECT_NE(std::string(e.what()).find("particle id 41"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("particle id 41 has a non-finite velocity"), std::string::npos) << e.what();
   }
 }
 

@@ -109,8 +109,12 @@ class KickDriftStepper final : public Stepper<Real> {
     if (!(double(furthest) > escape_length)) return {};
     for (std::size_t i = begin; i < end; ++i) {
       if (outside_by(i) != furthest) continue;
+      // The update's own terms (velocity and acceleration are still those it used).
       const auto v = p.velocity.get(i).template cast<double>();
-      return {true, static_cast<std::uint64_t>(p.id[i]), double(furthest), std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z)};
+      const auto a = p.acceleration.get(i).template cast<double>();
+      const double t = double(dt), a_term = method_ == Method::VelocityVerlet ? 0.5 * t * t : 0.0;
+      const auto moved = v * t + a * a_term;
+      return {true, static_cast<std::uint64_t>(p.id[i]), double(furthest), norm(v), norm(a), norm(moved)};
     }
     return {};
   }

@@ -50,7 +50,9 @@ struct Escape {
   bool found = false;
   std::uint64_t id = 0;
   double excess = 0;  // distance outside the box
-  double speed = 0;   // |v| during the position update
+  double speed = 0;         // |v| at the start of the position update
+  double acceleration = 0;  // |a| at the start of the position update
+  double displacement = 0;  // how far the update moved it (before the wall's projection)
 };
 
 struct StepOutcome {

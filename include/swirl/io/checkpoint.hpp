@@ -18,7 +18,9 @@
 // state beyond the fields, each under its owner's prefix: the simulation's
 // clock ("clock.*": the adaptive controller's previous step and floor), the
 // stepper's and every solver's state ("sph.*", "self_gravity.*") and every
-// observer's ("frames.*", "diagnostics.*", "checkpoints.*"), so that a resumed
+// observer's ("frames.*", "diagnostics.*", "checkpoints.*") and where the run
+// ends ("run.end_step" or "run.end_time"; absent in files of earlier builds of
+// version 2, whose resume then ends at the scene's end), so that a resumed
 // run is bit-identical to one that never stopped (sim/simulation.hpp,
 // sim/observer.hpp). The step and the time reached are in the header.
 //

@@ -125,6 +125,9 @@ struct Scene {
   double force_factor = 0.4;               // simulation.force_factor: C_force, SPH Δt ≤ C_force·sqrt(h/|a|max)
   double viscous_factor = 0.125;           // simulation.viscous_factor: C_visc, SPH Δt ≤ C_visc·h²·ρ/μ
   double eta = 0.75;                       // simulation.eta: η, gravity Δt ≤ η·sqrt(ε/|a|max)
+  // simulation.max_energy_error: a run whose forces and walls all conserve energy
+  // stops (a blow-up) when |E − E0|/|E0| at an output time exceeds this; 0 = never.
+  double max_energy_error = 0.1;
 
   bool walls = true;                       // a [box] section: walls; without one, open space
   Box<double> box;                         // box.min, box.max, m (used only with walls)

@@ -9,11 +9,15 @@
 //                 condition moves a particle less than h);
 //   TimeStep      a fixed Δt exceeds a time-step condition (a solver's add_limits())
 //                 of the state the next step starts from;
-//   StepCollapse  an adaptive Δt fell below its floor (dt_min).
+//   StepCollapse  an adaptive Δt fell below its floor (dt_min);
+//   EnergyDrift   the relative energy error of a run whose every force conserves
+//                 energy passed simulation.max_energy_error (checked at each
+//                 diagnostics row, i.e. each output time; sim/run.hpp).
 // Every message names the step, the time, a particle id, the offending
 // quantity and a suggested fix.
 #pragma once
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -21,15 +25,17 @@
 
 namespace swirl {
 
-enum class BlowUpCause { NonFinite, LeftDomain, TimeStep, StepCollapse };
+enum class BlowUpCause { NonFinite, LeftDomain, TimeStep, StepCollapse, EnergyDrift };
+inline constexpr std::size_t kBlowUpCauses = 5;
 
-// "non-finite state", "left the domain", "time-step condition", "time step collapsed".
+// "non-finite state", "left the domain", "time-step condition", "time step collapsed", "energy error".
 inline std::string_view to_string(BlowUpCause cause) {
   switch (cause) {
     case BlowUpCause::NonFinite: return "non-finite state";
     case BlowUpCause::LeftDomain: return "left the domain";
     case BlowUpCause::TimeStep: return "time-step condition";
     case BlowUpCause::StepCollapse: return "time step collapsed";
+    case BlowUpCause::EnergyDrift: return "energy error";
   }
   return "?";
 }

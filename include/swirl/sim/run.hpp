@@ -12,7 +12,10 @@
 // Blow-ups (sim/blow_up.hpp, docs/stability.md): a failed check stops the run
 // with RunSummary::error naming the step, time, particle, quantity and a fix,
 // keeping every frame and checkpoint written before; OnBlowUp::Warn reports it
-// through RunOptions::on_warning instead (rate-limited) and goes on. With
+// through RunOptions::on_warning instead (rate-limited), goes on, and counts it
+// in RunSummary::failed_checks. Runs whose forces and walls conserve energy
+// also check the relative energy error at each output time against
+// simulation.max_energy_error. With
 // dt = "adaptive" frames land exactly on the output times, the run ends exactly
 // at its end time, and diagnostics.csv gains the step history per frame: steps
 // so far, the smallest and largest step since the previous frame, the step the
@@ -74,7 +77,8 @@ struct RunOptions {
 // Reported after start() and after every step.
 struct RunProgress {
   std::uint64_t step = 0;
-  std::uint64_t total_steps = 0;  // adaptive steps: an estimate from the current step size
+  std::uint64_t first_step = 0;   // where this invocation started (the checkpoint's step on resume)
+  std::uint64_t total_steps = 0;  // the step the run ends at, ≥ step; adaptive steps: an estimate from the current step size
   double sim_time = 0;       // s
   double wall_seconds = 0;   // since the run started stepping
 };
@@ -100,6 +104,10 @@ struct RunSummary {
   std::uint64_t first_step = 0;         // 0, or the checkpoint's step when resumed
   std::filesystem::path last_checkpoint;  // the newest checkpoint written or resumed from
   std::vector<std::string> warnings;    // e.g. a corrupt checkpoint skipped on resume
+  // OnBlowUp::Warn: one line per kind of check that failed and went on,
+  // e.g. "20 steps failed the 'time-step condition' check". A run with any
+  // did not do what was asked, though it reached its end (the CLI exits 1).
+  std::vector<std::string> failed_checks;
 };
 
 // Refuses, before anything is allocated, a scene whose particles would not fit

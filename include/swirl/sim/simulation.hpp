@@ -17,6 +17,10 @@
 //   guard    a non-finite state throws SimulationError; a particle that left
 //            the box, a fixed Δt beyond a condition or a collapsed adaptive Δt
 //            throws too, or (OnBlowUp::Warn) is reported through take_events().
+//            Checks made outside the step (the run's energy error) go through
+//            fail_check() and obey the same policy.
+// start() refuses initial forces that are not finite (two particles on one
+// spot without softening): no step is to blame, so the message says so.
 // Messages name the step, the time, the particle id, the quantity, and the fix
 // the solvers advise.
 //
@@ -44,6 +48,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -138,6 +143,7 @@ class Simulation {
     Evaluation forces(*this);
     stepper_->start(particles_, forces, time(), settings_.block_size);
     rescan();
+    if (scan_.non_finite != kNoParticle) throw_non_finite(scan_.non_finite);
     started_ = true;
   }
 
@@ -233,6 +239,13 @@ class Simulation {
     return *best;
   }
   const StepScan& scan() const { return scan_; }
+  // A check made outside step() failed (e.g. the run's energy error): with
+  // OnBlowUp::Stop throws SimulationError "<where>: blow-up: <problem>; fix: ...",
+  // with Warn records it for take_events(), with Off does nothing.
+  void fail_check(BlowUpCause cause, std::string_view problem) {
+    if (settings_.on_blow_up == OnBlowUp::Off) return;
+    report(cause, fmt::format("{}: blow-up: {}; {}", where(), problem, fix_for_dt(suggested_dt())));
+  }
   // Failed checks of OnBlowUp::Warn since the last call.
   std::vector<GuardEvent> take_events() { return std::exchange(events_, {}); }
   const SimulationSettings& settings() const { return settings_; }
@@ -336,9 +349,11 @@ class Simulation {
   }
 
   std::string fix_for_dt(double suggested) const {
-    std::string fix = settings_.adaptive ? std::string("fix: ")
-                                         : fmt::format("fix: a smaller dt (at most {:.3g}), or dt = \"adaptive\"; ", suggested);
-    return fix + advice();
+    if (settings_.adaptive) return "fix: " + advice();
+    // A broken state can give limits of 0 or NaN: no number to suggest then.
+    const std::string dt = suggested > 0 && std::isfinite(suggested) ? fmt::format("a smaller dt (at most {:.3g})", suggested)
+                                                                     : std::string("a much smaller dt");
+    return fmt::format("fix: {}, or dt = \"adaptive\"; {}", dt, advice());
   }
 
   // A smaller step to suggest: a quarter of this one, or the tightest limit.
@@ -356,20 +371,28 @@ class Simulation {
           names += fmt::format("{}{}", names.empty() ? "" : ", ", f.name);
           break;
         }
-    throw SimulationError(
-        fmt::format("{}: blow-up: particle id {} has a non-finite {} (x = ({}, {}, {}), v = ({}, {}, {})); "
-                    "the time step {} is probably too large for the forces; {}",
-                    where(), particles_.id[i], names, particles_.position.x[i], particles_.position.y[i],
-                    particles_.position.z[i], particles_.velocity.x[i], particles_.velocity.y[i],
-                    particles_.velocity.z[i], last_dt_, fix_for_dt(suggested_dt())),
-        BlowUpCause::NonFinite);
+    const std::string state =
+        fmt::format("particle id {} has a non-finite {} (x = ({}, {}, {}), v = ({}, {}, {}))", particles_.id[i], names,
+                    particles_.position.x[i], particles_.position.y[i], particles_.position.z[i],
+                    particles_.velocity.x[i], particles_.velocity.y[i], particles_.velocity.z[i]);
+    if (clock_.step == 0 && last_dt_ == 0)  // start(): the forces of the initial state, no step taken
+      throw SimulationError(
+          fmt::format("before the first step: blow-up: the forces of the initial state are not finite: {}; no time "
+                      "step is involved: two particles at the same place without softening, or an initial value out "
+                      "of range; fix: {}",
+                      state, advice()),
+          BlowUpCause::NonFinite);
+    throw SimulationError(fmt::format("{}: blow-up: {}; the time step {} is probably too large for the forces; {}", where(),
+                                      state, last_dt_, fix_for_dt(suggested_dt())),
+                          BlowUpCause::NonFinite);
   }
 
   std::string escape_message(const integrate::Escape& e) const {
     return fmt::format(
         "{}: blow-up: particle id {} left the box: it ended a position update {:.3g} outside a wall, more than "
-        "the kernel support h = {:.3g} (its speed was {:.3g}, so |v|·dt = {:.3g}); {}",
-        where(), e.id, e.excess, settings_.escape_length, e.speed, e.speed * last_dt_, fix_for_dt(suggested_dt()));
+        "the kernel support h = {:.3g} (that update moved it {:.3g} in dt = {:.3g}: speed {:.3g}, acceleration {:.3g}); {}",
+        where(), e.id, e.excess, settings_.escape_length, e.displacement, last_dt_, e.speed, e.acceleration,
+        fix_for_dt(suggested_dt()));
   }
 
   std::string condition_message(const StepLimit& l) const {
