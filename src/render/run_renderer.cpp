@@ -285,11 +285,11 @@ void RunRenderer::render_file(const std::filesystem::path& frame_file, const std
 
 namespace swirl::render {
 
-std::function<void(const std::filesystem::path&, double)> render_every(std::filesystem::path run_dir,
-                                                                       std::uint64_t every, RenderOptions options) {
+sim::FrameHook render_every(std::filesystem::path run_dir, std::uint64_t every, RenderOptions options) {
   if (every == 0) throw std::invalid_argument("render every 0 frames: give at least 1");
   auto renderer = std::make_shared<std::unique_ptr<RunRenderer>>();
-  return [run_dir = std::move(run_dir), every, options, renderer](const std::filesystem::path& frame, double) {
+  return [run_dir = std::move(run_dir), every, options, renderer](const std::filesystem::path& frame, double,
+                                                                  const sim::ClaimFile& claim) {
     const auto number = frame_number(frame.stem().string());
     if (!number || *number % every != 0) return;
     std::filesystem::path vtp = frame;
@@ -301,7 +301,7 @@ std::function<void(const std::filesystem::path&, double)> render_every(std::file
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
     if (ec) throw io::IoError(out.string() + ": cannot create (" + ec.message() + ")");
-    (*renderer)->render_file(vtp, png_path_for(out, vtp));
+    (*renderer)->render_file(vtp, claim(png_path_for(out, vtp)));
   };
 }
 

@@ -89,14 +89,14 @@ class FrameWriter final : public Observer<Real> {
     }
     ++frames_;
     last_step_ = sim.step_count();
-    if (on_frame_) on_frame_(first, sim.time());
+    if (on_frame_) on_frame_(first, sim.time(), [this](const std::filesystem::path& p) { return folder_.claim(p); });
   }
 
   std::vector<scene::OutputFormat> formats_;
   std::filesystem::path dir_;
   io::PvdSeries series_;
   IntervalSchedule schedule_;
-  std::function<void(const std::filesystem::path&, double)> on_frame_;
+  FrameHook on_frame_;
   io::RunFolder& folder_;
   std::size_t frames_ = 0;
   std::uint64_t last_step_ = 0;

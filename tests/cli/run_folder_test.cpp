@@ -59,3 +59,25 @@ TEST_F(RunFolder, OverwriteCannotGoWithResume) {
 }
 
 }  // namespace
+
+// A sibling of finding 1: the pictures of --render-every are the run's files
+// too (listed in its manifest), so --overwrite deletes them with the frames,
+// and a picture the run did not make is never drawn over.
+TEST_F(RunFolder, RenderedPicturesAreTheRunsFiles) {
+  const auto run = dir_ / "R";
+  ASSERT_EQ(swirl("run " + kGravity + " --steps 16 --render-every 1 --out " + run.string()).status, 0);
+  ASSERT_TRUE(fs::exists(run / "render" / "particles_000001.png"));
+  EXPECT_NE(slurp(run / "manifest.txt").find("render/particles_000001.png"), std::string::npos);
+  put(run / "render" / "mine.png", "the user's\n");
+  const auto replaced = swirl("run " + kGravity + " --steps 8 --out " + run.string() + " --overwrite");
+  ASSERT_EQ(replaced.status, 0) << replaced.err;
+  EXPECT_FALSE(fs::exists(run / "render" / "particles_000001.png"));  // the old run's, gone
+  EXPECT_EQ(slurp(run / "render" / "mine.png"), "the user's\n");
+  // A folder with a picture of the user's where the run would draw: refused, the picture kept.
+  const auto other = dir_ / "S";
+  put(other / "render" / "particles_000000.png", "the user's\n");
+  const auto r = swirl("run " + kGravity + " --steps 8 --render-every 1 --out " + other.string());
+  EXPECT_NE(r.status, 0);
+  EXPECT_NE(r.err.find("particles_000000.png"), std::string::npos) << r.err;
+  EXPECT_EQ(slurp(other / "render" / "particles_000000.png"), "the user's\n");
+}

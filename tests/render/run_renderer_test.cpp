@@ -191,7 +191,13 @@ TEST(RunRenderer, DrawsTheParticlesTheTimeAndTheColourBar) {
 TEST(RunRenderer, RenderEveryDrawsOnlyEveryKthFrame) {
   FakeRun run;
   const auto hook = render_every(run.dir.path, 2, small());
-  for (int k = 0; k < 5; ++k) hook(run.add_frame(30, 0.1 * k, 0, 1.0), 0.1 * k);
+  std::vector<fs::path> claimed;
+  const auto claim = [&](const fs::path& p) {
+    claimed.push_back(p);
+    return p;
+  };
+  for (int k = 0; k < 5; ++k) hook(run.add_frame(30, 0.1 * k, 0, 1.0), 0.1 * k, claim);
+  EXPECT_EQ(claimed.size(), 3u);  // every picture it draws is claimed first
   for (int k = 0; k < 5; ++k) {
     const fs::path png = run.dir.path / "render" / ("particles_00000" + std::to_string(k) + ".png");
     EXPECT_EQ(fs::exists(png), k % 2 == 0) << png;

@@ -31,6 +31,7 @@
 #include "swirl/render/font.hpp"
 #include "swirl/render/frame.hpp"
 #include "swirl/render/image.hpp"
+#include "swirl/sim/run.hpp"
 
 namespace swirl::render {
 
@@ -100,9 +101,9 @@ class RunRenderer {
 // call, from the run's frame 0 (already on disk then, also on resume), so the
 // pictures match `swirl render --all`. It only reads frames, so the run's
 // results do not change; a failure throws io::IoError, which stops the run
-// like a failed frame write.
-std::function<void(const std::filesystem::path& frame, double time)> render_every(std::filesystem::path run_dir,
-                                                                                  std::uint64_t every,
-                                                                                  RenderOptions options = {});
+// like a failed frame write. Each picture is claimed in the run's manifest
+// before it is drawn: a picture the run did not make is never overwritten,
+// and --overwrite deletes the run's pictures with its frames.
+sim::FrameHook render_every(std::filesystem::path run_dir, std::uint64_t every, RenderOptions options = {});
 
 }  // namespace swirl::render

@@ -37,6 +37,14 @@
 
 namespace swirl::sim {
 
+// Records a file in the run folder's manifest before it is written and returns
+// its full path; throws io::RunFolderError for a file that exists and is not
+// this run's (io/run_folder.hpp). Every file a run makes goes through one.
+using ClaimFile = std::function<std::filesystem::path(const std::filesystem::path& path)>;
+// Called after each frame has been written, with the frame's file, its
+// simulated time, and the claim for any file the hook writes itself.
+using FrameHook = std::function<void(const std::filesystem::path& frame, double time, const ClaimFile& claim)>;
+
 struct RunOptions {
   std::filesystem::path out_dir = "out";
   int threads = 0;                      // 0: OpenMP's default (OMP_NUM_THREADS or all cores)
@@ -62,10 +70,9 @@ struct RunOptions {
   // writes a checkpoint and returns with RunSummary::interrupted.
   const std::atomic<bool>* stop = nullptr;
 
-  // Called after each frame has been written, with the frame's file and its
-  // simulated time (e.g. to render it while the run goes on). An exception
-  // thrown here stops the run like a write failure.
-  std::function<void(const std::filesystem::path& frame, double time)> on_frame;
+  // Called after each frame has been written (e.g. to render it while the run
+  // goes on). An exception thrown here stops the run like a write failure.
+  FrameHook on_frame;
 
   // What a failed blow-up check does (stop, or warn and go on).
   OnBlowUp on_blow_up = OnBlowUp::Stop;
