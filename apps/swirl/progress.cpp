@@ -26,8 +26,8 @@ void ProgressDisplay::update(const sim::RunProgress& p) {
   const std::uint64_t taken = p.step - std::min(p.first_step, p.step), left = p.total_steps - std::min(p.step, p.total_steps);
   const double rate = p.wall_seconds > 0 ? static_cast<double>(taken) / p.wall_seconds : 0.0;
   const double eta = rate > 0 ? static_cast<double>(left) / rate : 0.0;
-  const std::string stats = fmt::format("step {}/{}  t = {:.4g} s  {:.1f} steps/s  ETA {:.0f} s", p.step,
-                                        p.total_steps, p.sim_time, rate, std::ceil(eta));
+  const std::string stats = fmt::format("step {}/{}  t = {:.4g}{}{}  {:.1f} steps/s  ETA {:.0f} s", p.step, p.total_steps,
+                                        p.sim_time, p.time_unit.empty() ? "" : " ", p.time_unit, rate, std::ceil(eta));
   if (terminal_) {
     constexpr int width = 30;
     const int filled = std::clamp(static_cast<int>(fraction * width), 0, width);

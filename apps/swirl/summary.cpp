@@ -36,7 +36,8 @@ std::string summary_text(const sim::RunSummary& s) {
   std::string out;
   out += fmt::format("  scene            {}\n", s.scene_file);
   out += fmt::format("  particles        {} ({})\n", s.particles, s.precision);
-  out += fmt::format("  steps            {} (t = {:.6g} s)\n", s.steps, s.sim_time);
+  out += fmt::format("  steps            {} (t = {:.6g}{}{})\n", s.steps, s.sim_time, s.time_unit.empty() ? "" : " ",
+                     s.time_unit);
   out += fmt::format("  wall time        {:.3f} s\n", s.wall_seconds);
   out += fmt::format("  steps per second {:.2f}\n", s.steps_per_second);
   out += fmt::format("  threads          {}\n", s.threads);

@@ -381,7 +381,8 @@ class Progress final : public Observer<Real> {
  public:
   using Callback = std::function<void(const RunProgress&)>;
   using Total = std::function<std::uint64_t()>;
-  Progress(Callback callback, Total total) : callback_(std::move(callback)), total_(std::move(total)) {}
+  Progress(Callback callback, Total total, std::string_view time_unit)
+      : callback_(std::move(callback)), total_(std::move(total)), time_unit_(time_unit) {}
   std::string_view name() const override { return "progress"; }
   // The wall clock runs from construction: before start() and frame 0, as the phase timers do.
   void on_start(Simulation<Real>& sim, bool) override {
@@ -399,10 +400,11 @@ class Progress final : public Observer<Real> {
 
  private:
   void report(const Simulation<Real>& sim) const {
-    if (callback_) callback_({sim.step_count(), first_step_, total_(), sim.time(), wall()});
+    if (callback_) callback_({sim.step_count(), first_step_, total_(), sim.time(), wall(), time_unit_});
   }
   Callback callback_;
   Total total_;
+  std::string_view time_unit_;
   std::chrono::steady_clock::time_point started_ = std::chrono::steady_clock::now();
   std::uint64_t first_step_ = 0;
   double dt_min_ = std::numeric_limits<double>::infinity(), dt_max_ = 0;
@@ -549,7 +551,9 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   auto frames = std::make_unique<FrameWriter<Real>>(scene, options, folder);
   auto diagnostics = std::make_unique<DiagnosticsLog<Real>>(scene, options, sim, folder);
   auto guard = std::make_unique<GuardReporter<Real>>(options.on_warning);
-  auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps);
+  const std::string_view time_unit = scene.units == scene::Units::SI ? "s" : "";  // a literal: outlives the run
+  summary.time_unit = std::string(time_unit);
+  auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps, time_unit);
   std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get(), guard.get()};
   auto collect = [&](NamedValues& values) {
     end.save(values);

@@ -86,8 +86,9 @@ struct RunProgress {
   std::uint64_t step = 0;
   std::uint64_t first_step = 0;   // where this invocation started (the checkpoint's step on resume)
   std::uint64_t total_steps = 0;  // the step the run ends at, ≥ step; adaptive steps: an estimate from the current step size
-  double sim_time = 0;       // s
+  double sim_time = 0;       // in time_unit
   double wall_seconds = 0;   // since the run started stepping
+  std::string_view time_unit = "s";  // "s" (simulation.units = "si"), "" in N-body units
 };
 
 struct RunSummary {
@@ -97,7 +98,8 @@ struct RunSummary {
   int threads = 1;
   std::size_t particles = 0;
   std::uint64_t steps = 0;              // steps actually taken
-  double sim_time = 0;                  // s reached
+  double sim_time = 0;                  // reached, in time_unit
+  std::string time_unit = "s";          // "s" (simulation.units = "si"), "" in N-body units
   double wall_seconds = 0;              // stepping and output, without set-up
   double steps_per_second = 0;
   std::vector<std::pair<std::string, double>> phases;  // seconds per phase
