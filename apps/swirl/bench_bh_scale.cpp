@@ -144,8 +144,8 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
         const auto& mp = pt.mp;
         const auto& cr = pt.cr;
         gravity::GravitySettings g;
-        g.scheme = gravity::Scheme::global;
-        g.tree = gravity::Tree::linear;
+        g.scheme = gravity::Scheme::Global;
+        g.tree = gravity::Tree::Linear;
         g.multipole = gravity::parse_multipole(mp);
         g.criterion = gravity::parse_criterion(cr);
         g.walk = gravity::parse_walk(pt.walk);

@@ -103,7 +103,7 @@ Settled settle(std::size_t n, double aimed_k, int steps) {
   {
     auto probe = sim::build_simulation<float>(random_box(n, target));
     probe.start();
-    initial = fluid_of(probe).mean_neighbors();
+    initial = fluid_of(probe).mean_neighbours();
     if (initial > 0) target = aimed_k * aimed_k / initial;
   }
   Settled s{random_box(n, target), {}, target, 0, 0, 0};
@@ -113,12 +113,12 @@ Settled settle(std::size_t n, double aimed_k, int steps) {
   // the guard warns (counted) instead of stopping; a non-finite state still stops.
   run.set_on_blow_up(OnBlowUp::Warn);
   run.start();
-  s.initial_k = fluid_of(run).mean_neighbors();
+  s.initial_k = fluid_of(run).mean_neighbours();
   for (int i = 0; i < steps; ++i) {
     run.step();
     s.warnings += run.take_events().size();
   }
-  s.settled_k = fluid_of(run).mean_neighbors();
+  s.settled_k = fluid_of(run).mean_neighbours();
   s.particles = run.particles();
   return s;
 }
@@ -146,7 +146,7 @@ Timing time_steps(const scene::Scene& scene, const ParticleSet<float>& start, in
   const auto t0 = std::chrono::steady_clock::now();
   for (int s = 0; s < steps; ++s) {
     run.step();
-    t.mean_k += fluid_of(run).mean_neighbors();
+    t.mean_k += fluid_of(run).mean_neighbours();
     t.warnings += run.take_events().size();
   }
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -437,7 +437,7 @@ int run_hash_stats(HashStatsArgs a, const CommonArgs& common) {
   t.title = fmt::format("Hash table statistics (Table 5.2) after {} settling steps", a.settle);
   t.columns = {{"statistic", "statistic"}, {"swirl", "swirl"}, {"thesis", "thesis (Table 5.2, PPC 970 run)"}};
   t.add({text("particles"), integer(static_cast<long long>(stats.particles)), integer(static_cast<long long>(th.particles))});
-  t.add({text("mean_neighbours"), number(stats.mean_neighbors(), 2), number(seeds::kThesisTable52Neighbours, 0)});
+  t.add({text("mean_neighbours"), number(stats.mean_neighbours(), 2), number(seeds::kThesisTable52Neighbours, 0)});
   t.add({text("hash_table_size"), integer(static_cast<long long>(stats.buckets)), integer(static_cast<long long>(th.buckets))});
   t.add({text("empty_buckets_pct"), number(100 * stats.empty_fraction(), 1), number(100 * th.empty_buckets, 0)});
   t.add({text("colliding_buckets_pct_of_nonempty"), number(100 * stats.collision_fraction(), 1),

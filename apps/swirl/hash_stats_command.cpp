@@ -31,7 +31,7 @@ int hash_stats(const HashStatsArgs& args) {
   if (args.threads > 0) parallel::set_thread_count(args.threads);
   const auto s = sim::scene_hash_statistics(scene, args.steps);
   fmt::print("hash-stats: {}: {} particles, h = {} m, {} mean neighbours{}\n", scene.file, s.particles,
-             scene.sph->smoothing_length, s.mean_neighbors(),
+             scene.sph->smoothing_length, s.mean_neighbours(),
              args.steps ? fmt::format(", after {} steps", args.steps) : std::string(" (initial positions)"));
   const auto& t = seeds::kThesisTable52;  // typed once, with the other seed figures
   fmt::print("  {:<52} {:>14} {:>30}\n", "", "swirl", fmt::format("thesis, Table 5.2 (N = {})", t.particles));

@@ -40,7 +40,8 @@
 namespace {
 
 using namespace swirl::gravity;
-constexpr std::array<Scheme, 3> kSchemes{Scheme::subdomain, Scheme::subtree, Scheme::global};
+using swirl::KernelPath;
+constexpr std::array<Scheme, 3> kSchemes{Scheme::Subdomain, Scheme::Subtree, Scheme::Global};
 
 template <class Real>
 void force(benchmark::State& state) {
@@ -97,8 +98,8 @@ void BM_Table2(benchmark::State& state) {
 constexpr double kAssumedPeakFloatGflops = 2 * 16 * 2 * 4.4;
 
 constexpr std::array<const char*, 3> kKernelNames{"particle", "monopole", "quadrupole"};
-constexpr std::array<swirl::simd::Isa, 3> kKernelIsas{swirl::simd::Isa::sse2, swirl::simd::Isa::avx2,
-                                                      swirl::simd::Isa::avx512};
+constexpr std::array<swirl::simd::Isa, 3> kKernelIsas{swirl::simd::Isa::Sse2, swirl::simd::Isa::Avx2,
+                                                      swirl::simd::Isa::Avx512};
 
 template <class Real>
 void kernel(benchmark::State& state) {
@@ -106,7 +107,7 @@ void kernel(benchmark::State& state) {
   const auto path_index = std::size_t(state.range(1));
   const auto n_targets = std::size_t(state.range(2));
   const auto n_sources = std::size_t(state.range(3));
-  const KernelPath path = path_index == 0 ? KernelPath::scalar : KernelPath::simd;
+  const KernelPath path = path_index == 0 ? KernelPath::Scalar : KernelPath::Simd;
   std::string label = std::string(kKernelNames[kind]) + " ";
   swirl::simd::Isa isa = swirl::simd::active();
   if (path_index > 0) {
@@ -209,7 +210,7 @@ __attribute__((target("avx2,fma"))) float fma_chains_256(long n) {
 void BM_PeakFma(benchmark::State& state) {
 #if defined(__x86_64__) && defined(__GNUC__)
   const bool wide = state.range(0) == 512;
-  if (!swirl::simd::cpu_supports(wide ? swirl::simd::Isa::avx512 : swirl::simd::Isa::avx2)) {
+  if (!swirl::simd::cpu_supports(wide ? swirl::simd::Isa::Avx512 : swirl::simd::Isa::Avx2)) {
     state.SkipWithError("this CPU has no such FMA");
     return;
   }

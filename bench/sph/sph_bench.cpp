@@ -60,7 +60,7 @@ ParticleSet<Real> random_box(std::size_t n) {
 
 sph::SphParameters params_for(std::size_t n, sph::NeighbourSearch search, bool simd) {
   sph::SphParameters s;
-  s.smoothing_length = sph::smoothing_length_for_neighbors(25, 1.0 / double(n));
+  s.smoothing_length = sph::smoothing_length_for_neighbours(25, 1.0 / double(n));
   s.rest_density = 1000;
   s.sound_speed = 1;
   s.viscosity = 0.05;
@@ -102,7 +102,7 @@ void BM_Search(benchmark::State& state) {
   spatial::ParticleOrder<Real> order;  // the grid's search: the shared order's sort, then the cell index
   order.set_request(sph::SphFluid<Real>(s).order_request());
   spatial::SpatialHash<Real> hash;
-  spatial::NeighborList<Real> lists;
+  spatial::NeighbourList<Real> lists;
   const sph::Poly6<Real> w(Real(s.smoothing_length));
   double neighbours = 0;
   for (auto _ : state) {
@@ -114,7 +114,7 @@ void BM_Search(benchmark::State& state) {
     } else {
       hash.build(p, Real(s.smoothing_length), sph::default_bucket_count(n), kBlock);
       Real* rho = p.density.data();
-      hash.find_neighbors(p, true, kBlock, lists, [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t c) {
+      hash.find_neighbours(p, true, kBlock, lists, [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t c) {
         Real sum = 0;
         for (std::size_t k = 0; k < c; ++k) sum += p.mass[nb[k]] * w(r2[k]);
         rho[i] = sum;
@@ -125,7 +125,7 @@ void BM_Search(benchmark::State& state) {
   if (grid) {  // the pairs the grid's passes will process
     sph::SphFluid<Real> fluid(s);
     evaluate_alone(fluid, p, kBlock);
-    neighbours = fluid.mean_neighbors();
+    neighbours = fluid.mean_neighbours();
   }
   report(state, n, neighbours);
   state.SetLabel(grid ? "grid" : "hash");
@@ -144,18 +144,17 @@ void grid_pass(benchmark::State& state) {
   evaluate_alone(fluid, p, order, kBlock);  // sorts p and fills density
   const auto k = constants(s);
   sph::GridScratch<Real> scratch;
-  sph::grid_density<Real, true>(fluid.grid(), p, k, kBlock, scratch);
+  const KernelPath path = simd ? KernelPath::Simd : KernelPath::Scalar;
+  sph::grid_density(fluid.grid(), p, k, kBlock, scratch, KernelPath::Simd);
   for (auto _ : state) {
     if constexpr (Forces) {
-      if (simd) sph::grid_forces<Real, true>(fluid.grid(), p, k, kBlock, scratch);
-      else sph::grid_forces<Real, false>(fluid.grid(), p, k, kBlock, scratch);
+      sph::grid_forces(fluid.grid(), p, k, kBlock, scratch, path);
     } else {
-      benchmark::DoNotOptimize(simd ? sph::grid_density<Real, true>(fluid.grid(), p, k, kBlock, scratch)
-                                    : sph::grid_density<Real, false>(fluid.grid(), p, k, kBlock, scratch));
+      benchmark::DoNotOptimize(sph::grid_density(fluid.grid(), p, k, kBlock, scratch, path));
     }
     benchmark::DoNotOptimize(p.acceleration.x.data());
   }
-  report(state, n, fluid.mean_neighbors());
+  report(state, n, fluid.mean_neighbours());
   state.SetLabel(simd_label(simd));
 }
 void BM_Density(benchmark::State& state) { grid_pass<false>(state); }
@@ -177,7 +176,7 @@ void BM_Step(benchmark::State& state) {
   sim.add_solver(std::move(model));
   sim.start();
   for (auto _ : state) sim.step();
-  report(state, n, fluid->mean_neighbors());
+  report(state, n, fluid->mean_neighbours());
   state.counters["bytes_per_particle"] = double(fluid->scratch_bytes()) / double(n) + 16 * sizeof(Real) + 8;
   state.SetLabel(std::string(grid ? "grid " : "hash ") + simd_label(grid && state.range(3) != 0));
 }

@@ -87,6 +87,7 @@ LinearTreeSettings BarnesHut<Real>::linear_settings() const {
   ls.bucket_size = settings_.bucket_size;
   ls.walk = settings_.walk;
   ls.group_size = settings_.group_size;
+  ls.simd_kernels = settings_.simd;
   return ls;
 }
 
@@ -128,7 +129,7 @@ void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real
   const auto t0 = Clock::now();
   std::vector<std::uint64_t> weights;
   switch (settings_.scheme) {
-    case Scheme::subdomain:
+    case Scheme::Subdomain:
       build_subdomains(p);
       // Section 4.1.1: the first evaluation deals equal shares of particles,
       // later ones the nodes each sub-domain's tree explored the step before.
@@ -138,7 +139,7 @@ void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real
         for (const auto& [b, e] : runs_) weights.push_back(e - b);
       }
       break;
-    case Scheme::subtree:
+    case Scheme::Subtree:
       build_global_tree(p);
       cut_units();
       // Section 4.2.1: units are dealt by their number of nodes.
@@ -151,7 +152,7 @@ void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real
         weights.push_back(nodes);
       }
       break;
-    case Scheme::global:
+    case Scheme::Global:
       build_global_tree(p);
       break;
   }
@@ -162,7 +163,7 @@ void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real
   }
 
   const auto t1 = Clock::now();
-  if (settings_.scheme == Scheme::global) {
+  if (settings_.scheme == Scheme::Global) {
     walk_global(p, out, block_size);
     stats_.trees = 1;
   } else {

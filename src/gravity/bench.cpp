@@ -48,7 +48,7 @@ BenchResult run(const BenchSettings& b) {
   GravitySettings g;
   g.method = b.method;
   g.scheme = b.scheme;
-  g.tree = Tree::paper;  // the paper's tables measure the paper's tree (bh-scale measures the linear one)
+  g.tree = Tree::Paper;  // the paper's tables measure the paper's tree (bh-scale measures the linear one)
   g.opening = b.opening;
   g.softening = b.softening;
   GravityForce<Real> gravity(g);
@@ -115,7 +115,7 @@ std::vector<ForceError> errors_of(const BenchSettings& b, const std::vector<Forc
   for (const ForceErrorCase& c : cases) {
     GravitySettings g;
     g.scheme = c.scheme;
-    g.tree = Tree::paper;
+    g.tree = Tree::Paper;
     g.opening = c.opening;
     g.softening = b.softening;
     BarnesHut<Real> tree(g);
@@ -163,7 +163,7 @@ std::vector<ForceError> force_errors(const BenchSettings& b, const std::vector<F
   for (const ForceErrorCase& c : cases) {
     GravitySettings g;
     g.scheme = c.scheme;
-    g.tree = Tree::paper;
+    g.tree = Tree::Paper;
     g.opening = c.opening;
     g.softening = b.softening;
     validate(g);

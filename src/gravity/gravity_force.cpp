@@ -24,7 +24,7 @@ GravityForce<Real>::GravityForce(const GravitySettings& settings, const SelfGrav
 
 template <class Real>
 bool GravityForce<Real>::views_order() const {
-  return settings_.method == Method::barnes_hut && settings_.reorder && tree_.uses_linear_tree();
+  return settings_.method == Method::BarnesHut && settings_.reorder && tree_.uses_linear_tree();
 }
 
 template <class Real>
@@ -41,7 +41,7 @@ spatial::OrderRequest GravityForce<Real>::order_request() const {
 
 template <class Real>
 void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
-  if (settings_.method == Method::direct) {
+  if (settings_.method == Method::Direct) {
     const auto t0 = std::chrono::steady_clock::now();
     direct_sum(p, Real(settings_.softening), ctx.block_size, field_);
     stats_ = GravityStats{};

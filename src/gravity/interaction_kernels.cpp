@@ -88,7 +88,7 @@ void cell_field_simd(const SourceCells<Real>& s, const Targets<Real>& t, Real ep
 template <class Real>
 void add_particle_field(const SourceParticles<Real>& s, const Targets<Real>& t, Real eps2, KernelPath path) {
   if (t.n == 0 || s.n == 0) return;
-  if (path == KernelPath::scalar)
+  if (path == KernelPath::Scalar)
     particle_field_scalar(s, t, eps2);
   else
     particle_field_simd(s, t, eps2);
@@ -97,7 +97,7 @@ void add_particle_field(const SourceParticles<Real>& s, const Targets<Real>& t, 
 template <class Real>
 void add_cell_field(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, bool quadrupole, KernelPath path) {
   if (t.n == 0 || s.n == 0) return;
-  if (path == KernelPath::scalar)
+  if (path == KernelPath::Scalar)
     cell_field_scalar(s, t, eps2, quadrupole);
   else
     cell_field_simd(s, t, eps2, quadrupole);

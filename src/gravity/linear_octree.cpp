@@ -277,7 +277,7 @@ void LinearOctree<Real>::make_multipoles() {
   // Nodes are stored level by level: find each level's range.
   std::vector<std::size_t> level_start(std::size_t(depth_) + 2, count);
   for (std::size_t node = count; node-- > 0;) level_start[t.level[node]] = node;
-  const bool quadrupole = settings_.multipole == Multipole::quadrupole;
+  const bool quadrupole = settings_.multipole == Multipole::Quadrupole;
   for (int level = depth_; level >= 0; --level) {
     const std::size_t lb = level_start[std::size_t(level)], le = level_start[std::size_t(level) + 1];
     node_blocks("linear_octree_multipoles", le - lb, [&](std::size_t b, std::size_t e, std::size_t) {
@@ -358,7 +358,7 @@ void LinearOctree<Real>::make_multipoles() {
   for (auto* a : {&t.com_x, &t.com_y, &t.com_z, &t.mass, &t.qxx, &t.qxy, &t.qxz, &t.qyy, &t.qyz, &t.open2})
     a->resize(count);
   const double opening = settings_.opening;
-  const bool barnes = settings_.criterion == Criterion::barnes;
+  const bool barnes = settings_.criterion == Criterion::Barnes;
   node_blocks("linear_octree_store", count, [&](std::size_t b, std::size_t e, std::size_t) {
     for (std::size_t node = b; node < e; ++node) {
       const Moments& r = mom[node];
@@ -399,7 +399,7 @@ void LinearOctree<Real>::walk_one(std::size_t s, Accumulator<Real>& acc, WalkCou
   if (t.size() == 0) return;
   const Real tx = x_[s], ty = y_[s], tz = z_[s];
   const Real eps2 = Real(settings_.softening * settings_.softening);
-  const bool quadrupole = settings_.multipole == Multipole::quadrupole;
+  const bool quadrupole = settings_.multipole == Multipole::Quadrupole;
   const auto slot = std::uint32_t(s);
   std::array<std::uint32_t, kStackDepth> stack;
   std::size_t top = 0;
@@ -523,8 +523,8 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
   group_counts_.assign(groups, WalkCounts{});
   lists_.resize(std::size_t(std::max(parallel::thread_count(), 1)));
   const Real eps2 = Real(settings_.softening * settings_.softening);
-  const bool quadrupole = settings_.multipole == Multipole::quadrupole;
-  const KernelPath path = settings_.simd_kernels ? KernelPath::simd : KernelPath::scalar;
+  const bool quadrupole = settings_.multipole == Multipole::Quadrupole;
+  const KernelPath path = settings_.simd_kernels ? KernelPath::Simd : KernelPath::Scalar;
   parallel::for_blocks("linear_octree_group_walk", groups, 1, [&](std::size_t k, std::size_t, std::size_t) {
     const std::size_t g = schedule_[k];
     const auto thread = std::size_t(omp_get_thread_num());
@@ -574,7 +574,7 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
 template <class Real>
 WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size) {
   out.resize(x_.size());
-  if (settings_.walk == Walk::group) return evaluate_groups(out);
+  if (settings_.walk == Walk::Group) return evaluate_groups(out);
   return evaluate_particles(out, block_size);
 }
 

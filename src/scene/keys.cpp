@@ -360,14 +360,14 @@ std::vector<SceneKey> declare_scene_keys() {
                      .doc = "N, a root key in place of `[[particles]]`", .required = true, .custom_read = true},
             in_random_box(&Scene::RandomBox::particles)));
   add(field(SceneKey{.key = "random_box.neighbours", .section = "random_box", .range = kNeighbourCount, .doc = "k"},
-            in_random_box(&Scene::RandomBox::neighbors)));
+            in_random_box(&Scene::RandomBox::neighbours)));
   add(field(SceneKey{.key = "random_box.seed", .section = "random_box", .range = kNonNegative,
                      .doc = "seeds the positions"},
             in_random_box(&Scene::RandomBox::seed)));
 
   // [nbody]
   using gravity::GravitySettings;
-  const auto linear_tree = [](const Scene& s) { return s.nbody && s.nbody->tree == gravity::Tree::linear; };
+  const auto linear_tree = [](const Scene& s) { return s.nbody && s.nbody->tree == gravity::Tree::Linear; };
   add(field(SceneKey{.key = "nbody.method", .section = "nbody", .noun = "method",
                      .doc = "`\"barnes_hut\"` or `\"direct\"` (the exact O(N²) sum)"},
             in_nbody(&GravitySettings::method)));
@@ -390,15 +390,15 @@ std::vector<SceneKey> declare_scene_keys() {
                             "insertion-built tree); `\"linear\"` needs `scheme = \"global\"`",
                      .default_doc = "`\"linear\"` with `scheme = \"global\"`, else `\"paper\"`",
                      .context_default = [](const Scene& s) {
-                       const bool global = s.nbody && s.nbody->scheme == gravity::Scheme::global;
-                       return to_value(global ? gravity::Tree::linear : gravity::Tree::paper);
+                       const bool global = s.nbody && s.nbody->scheme == gravity::Scheme::Global;
+                       return to_value(global ? gravity::Tree::Linear : gravity::Tree::Paper);
                      }},
             in_nbody(&GravitySettings::tree)));
   add(field(SceneKey{.key = "nbody.multipole", .section = "nbody", .noun = "multipole",
                      .doc = "`\"monopole\"` or `\"quadrupole\"`; the paper tree is monopole only",
                      .default_doc = "`\"quadrupole\"` (linear tree), `\"monopole\"` (paper tree)",
                      .context_default = [linear_tree](const Scene& s) {
-                       return to_value(linear_tree(s) ? gravity::Multipole::quadrupole : gravity::Multipole::monopole);
+                       return to_value(linear_tree(s) ? gravity::Multipole::Quadrupole : gravity::Multipole::Monopole);
                      }},
             in_nbody(&GravitySettings::multipole)));
   add(field(SceneKey{.key = "nbody.opening_criterion", .section = "nbody", .noun = "opening criterion",
@@ -406,7 +406,7 @@ std::vector<SceneKey> declare_scene_keys() {
                             "paper tree takes `\"paper\"` only",
                      .default_doc = "`\"barnes\"` (linear tree), `\"paper\"` (paper tree)",
                      .context_default = [linear_tree](const Scene& s) {
-                       return to_value(linear_tree(s) ? gravity::Criterion::barnes : gravity::Criterion::paper);
+                       return to_value(linear_tree(s) ? gravity::Criterion::Barnes : gravity::Criterion::Paper);
                      }},
             in_nbody(&GravitySettings::criterion)));
   add(field(SceneKey{.key = "nbody.bucket_size", .section = "nbody", .unit = "particles", .range = kTreeSize,
@@ -418,13 +418,20 @@ std::vector<SceneKey> declare_scene_keys() {
                             "tree takes `\"particle\"` only",
                      .default_doc = "`\"group\"` (linear tree), `\"particle\"` (paper tree)",
                      .context_default = [linear_tree](const Scene& s) {
-                       return to_value(linear_tree(s) ? gravity::Walk::group : gravity::Walk::particle);
+                       return to_value(linear_tree(s) ? gravity::Walk::Group : gravity::Walk::Particle);
                      }},
             in_nbody(&GravitySettings::walk)));
   add(field(SceneKey{.key = "nbody.group_size", .section = "nbody", .unit = "particles", .range = kTreeSize,
                      .doc = "the group walk's groups hold at most this many particles (unless one leaf holds more); "
                             "256–512 was fastest at the accuracy target (docs/performance/gravity-tree.md)"},
             in_nbody(&GravitySettings::group_size)));
+  add(field(SceneKey{.key = "nbody.simd", .section = "nbody",
+                     .doc = "linear tree: explicit SIMD interaction kernels; `false` runs their scalar twin (for "
+                            "comparison)",
+                     // Not hashed, so that checkpoints of scenes from before the key keep their hash: it changes
+                     // rounding only, and a resume reads the value from the scene saved with the run.
+                     .hashed = false},
+            in_nbody(&GravitySettings::simd)));
   add(field(SceneKey{.key = "nbody.G", .section = "nbody", .unit = "length³/(mass·time²)", .range = kPositive,
                      .doc = "the gravitational constant, in the scene's units",
                      .default_doc = "`1` with `units = \"nbody\"`, `6.6743e-11` with `\"si\"`",

@@ -378,7 +378,7 @@ void read_sph(const Table& top, Scene& s) {
     t.fail("neighbours", fmt::format("needs a [[particles]] source of kind 'fluid_block' to size h from "
                                      "(or give {})", t.key("smoothing_length")));
   const double s0 = t.reader().number(*spacing, "particles[].spacing", Range{0, std::numeric_limits<double>::infinity(), true, false});
-  s.sph->smoothing_length = sph::smoothing_length_for_neighbors(k, s0 * s0 * s0);
+  s.sph->smoothing_length = sph::smoothing_length_for_neighbours(k, s0 * s0 * s0);
 }
 
 // [nbody]: self-gravity. Keys whose defaults follow the scheme and the tree
@@ -415,7 +415,7 @@ void read_random_box(const Table& top, Scene& s) {
   const Scene::RandomBox& rb = *s.random_box;
   const double h = s.sph->smoothing_length;
   const double side =
-      std::cbrt(static_cast<double>(rb.particles) * 4.0 / 3.0 * std::numbers::pi * h * h * h / rb.neighbors);
+      std::cbrt(static_cast<double>(rb.particles) * 4.0 / 3.0 * std::numbers::pi * h * h * h / rb.neighbours);
   s.box = {{0, 0, 0}, {side, side, side}};
   RandomSource src;
   src.region = s.box;
@@ -426,7 +426,7 @@ void read_random_box(const Table& top, Scene& s) {
   if (!(side > 0) || !std::isfinite(side) || !(src.mass > 0) || !std::isfinite(src.mass))
     t.fail("neighbours", fmt::format("the random box derived from sph.smoothing_length = {}, sph.rest_density = {} "
                                      "and neighbours = {} has side {} and particle mass {}: not usable",
-                                     h, s.sph->rest_density, rb.neighbors, side, src.mass));
+                                     h, s.sph->rest_density, rb.neighbours, side, src.mass));
   s.sources.emplace_back(src);
 }
 

@@ -57,17 +57,17 @@ class Checker {
   void nbody() const {
     if (!s_.nbody) return;
     const auto& g = *s_.nbody;
-    if (g.tree == gravity::Tree::linear && g.scheme != gravity::Scheme::global)
+    if (g.tree == gravity::Tree::Linear && g.scheme != gravity::Scheme::Global)
       fail("nbody.tree", fmt::format("\"linear\" needs nbody.scheme = \"global\" (the paper's scheme \"{}\" walks the "
                                      "paper's tree)",
                                      gravity::to_string(g.scheme)));
-    if (g.tree == gravity::Tree::linear) return;
-    if (g.multipole != gravity::Multipole::monopole)
+    if (g.tree == gravity::Tree::Linear) return;
+    if (g.multipole != gravity::Multipole::Monopole)
       fail("nbody.multipole", "the paper's tree is monopole only (use tree = \"linear\" with scheme = \"global\")");
-    if (g.criterion != gravity::Criterion::paper)
+    if (g.criterion != gravity::Criterion::Paper)
       fail("nbody.opening_criterion",
            "the paper's tree uses the paper's rule only (use tree = \"linear\" with scheme = \"global\")");
-    if (g.walk != gravity::Walk::particle)
+    if (g.walk != gravity::Walk::Particle)
       fail("nbody.walk", "the paper's tree walks per particle only (use tree = \"linear\" with scheme = \"global\")");
   }
 

@@ -62,7 +62,7 @@ B inverse_sqrt(const B& x) {
 
 template <class Real>
 std::uint64_t density_cell(const DensityKernelArgs<Real>& a, std::size_t first, std::size_t last,
-                           const CandidateRange* ranges, int count) {
+                           const IndexRange* ranges, int count) {
   using B = Batch<Real>;
   constexpr std::size_t W = kLanes<Real>;
   const Real *x = a.x, *y = a.y, *z = a.z, *m = a.mass;
@@ -113,7 +113,7 @@ std::uint64_t density_cell(const DensityKernelArgs<Real>& a, std::size_t first, 
 }
 
 template <class Real>
-void forces_cell(const ForceKernelArgs<Real>& a, std::size_t first, std::size_t last, const CandidateRange* ranges,
+void forces_cell(const ForceKernelArgs<Real>& a, std::size_t first, std::size_t last, const IndexRange* ranges,
                  int count) {
   using B = Batch<Real>;
   constexpr std::size_t W = kLanes<Real>;
@@ -182,19 +182,19 @@ void forces_cell(const ForceKernelArgs<Real>& a, std::size_t first, std::size_t 
 }  // namespace
 
 std::uint64_t density_cell_simd(const DensityKernelArgs<float>& a, std::size_t first, std::size_t last,
-                                const CandidateRange* ranges, int count) {
+                                const IndexRange* ranges, int count) {
   return density_cell(a, first, last, ranges, count);
 }
 std::uint64_t density_cell_simd(const DensityKernelArgs<double>& a, std::size_t first, std::size_t last,
-                                const CandidateRange* ranges, int count) {
+                                const IndexRange* ranges, int count) {
   return density_cell(a, first, last, ranges, count);
 }
 void forces_cell_simd(const ForceKernelArgs<float>& a, std::size_t first, std::size_t last,
-                      const CandidateRange* ranges, int count) {
+                      const IndexRange* ranges, int count) {
   forces_cell(a, first, last, ranges, count);
 }
 void forces_cell_simd(const ForceKernelArgs<double>& a, std::size_t first, std::size_t last,
-                      const CandidateRange* ranges, int count) {
+                      const IndexRange* ranges, int count) {
   forces_cell(a, first, last, ranges, count);
 }
 int grid_pass_float_lanes() { return static_cast<int>(kLanes<float>); }

@@ -42,7 +42,7 @@ std::string environment_error() {
 }
 
 TEST(SimdDispatch, NamesRoundTrip) {
-  for (Isa isa : {Isa::generic, Isa::sse2, Isa::avx2, Isa::avx512}) {
+  for (Isa isa : {Isa::Generic, Isa::Sse2, Isa::Avx2, Isa::Avx512}) {
     const auto parsed = parse_isa(isa_name(isa));
     ASSERT_TRUE(parsed.has_value()) << isa_name(isa);
     EXPECT_EQ(*parsed, isa);
@@ -80,7 +80,7 @@ TEST(SimdDispatch, AnUnknownNameIsAnErrorNamingTheVariable) {
 
 TEST(SimdDispatch, AnUnusableNameIsAnErrorNamingTheVariable) {
   int checked = 0;
-  for (Isa isa : {Isa::generic, Isa::sse2, Isa::avx2, Isa::avx512}) {
+  for (Isa isa : {Isa::Generic, Isa::Sse2, Isa::Avx2, Isa::Avx512}) {
     if (usable(isa)) continue;
     const std::string name(isa_name(isa));
     ScopedEnvironment env(name.c_str());
@@ -105,7 +105,7 @@ TEST(SimdDispatch, ScopedChoiceIsRestoredAndUnusableOnesRefused) {
     }
     EXPECT_EQ(active(), before);
   }
-  for (Isa isa : {Isa::generic, Isa::sse2, Isa::avx2, Isa::avx512})
+  for (Isa isa : {Isa::Generic, Isa::Sse2, Isa::Avx2, Isa::Avx512})
     if (!usable(isa)) {
       EXPECT_THROW(ScopedIsa{isa}, std::invalid_argument);
     }
@@ -113,9 +113,9 @@ TEST(SimdDispatch, ScopedChoiceIsRestoredAndUnusableOnesRefused) {
 }
 
 TEST(SimdDispatch, LanesGrowWithTheInstructionSet) {
-  EXPECT_EQ(float_lanes(Isa::sse2), 4);
-  EXPECT_EQ(float_lanes(Isa::avx2), 2 * float_lanes(Isa::sse2));
-  EXPECT_EQ(float_lanes(Isa::avx512), 2 * float_lanes(Isa::avx2));
+  EXPECT_EQ(float_lanes(Isa::Sse2), 4);
+  EXPECT_EQ(float_lanes(Isa::Avx2), 2 * float_lanes(Isa::Sse2));
+  EXPECT_EQ(float_lanes(Isa::Avx512), 2 * float_lanes(Isa::Avx2));
   EXPECT_TRUE(is_compiled(kCompiledIsas.front()));
 }
 

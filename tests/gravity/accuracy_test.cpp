@@ -39,7 +39,7 @@ constexpr double kP99PerLambda2 = 3.0 / 8;
 GravitySettings settings(Scheme scheme, double lambda) {
   GravitySettings s;
   s.scheme = scheme;
-  s.tree = Tree::paper;  // the paper's schemes and tree; the linear tree: linear_tree_test.cpp
+  s.tree = Tree::Paper;  // the paper's schemes and tree; the linear tree: linear_tree_test.cpp
   s.opening = lambda;
   s.softening = kEps;
   return s;

@@ -29,7 +29,7 @@ TEST(BenchTest, TimesEveryPhaseAndRestoresTheThreadCount) {
       EXPECT_GT(r.mean_nodes_visited, 0);
       // The paper-table harness builds the paper's trees: a leaf per particle.
       EXPECT_GT(r.nodes, 1024u);
-      EXPECT_EQ(r.trees > 1, scheme != Scheme::global);
+      EXPECT_EQ(r.trees > 1, scheme != Scheme::Global);
       EXPECT_EQ(parallel::thread_count(), saved);
     }
   }
@@ -73,7 +73,7 @@ TEST(BenchTest, ForceErrorsMatchTheirSlowTwinForAnyThreadCount) {
     for (std::size_t c = 0; c < cases.size(); ++c) {
       GravitySettings g;
       g.scheme = cases[c].scheme;
-      g.tree = Tree::paper;  // the paper-table harness measures the paper's tree
+      g.tree = Tree::Paper;  // the paper-table harness measures the paper's tree
       g.opening = cases[c].opening;
       g.softening = b.softening;
       const auto e = testing::relative_errors(testing::tree_field(p, g), exact, exact);
@@ -98,9 +98,9 @@ TEST(BenchTest, ForceErrorsMatchTheirSlowTwinForAnyThreadCount) {
 TEST(BenchTest, ForceErrorsRefuseBadCases) {
   BenchSettings b;
   b.n = 64;
-  EXPECT_THROW(force_errors(b, {{Scheme::global, 1.5}}), std::invalid_argument);
+  EXPECT_THROW(force_errors(b, {{Scheme::Global, 1.5}}), std::invalid_argument);
   b.threads = 0;
-  EXPECT_THROW(force_errors(b, {{Scheme::global, 0.5}}), std::invalid_argument);
+  EXPECT_THROW(force_errors(b, {{Scheme::Global, 0.5}}), std::invalid_argument);
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ TYPED_TEST(DiagnosticsTest, TwoBodiesByHand) {
   p.position.set(1, {Real(2), 0, 0});
   p.velocity.set(0, {0, Real(1), 0});
   p.velocity.set(1, {0, 0, Real(-1)});
-  for (Method method : {Method::direct, Method::barnes_hut}) {
+  for (Method method : {Method::Direct, Method::BarnesHut}) {
     GravitySettings s;
     s.method = method;
     s.softening = 0;

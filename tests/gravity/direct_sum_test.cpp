@@ -112,7 +112,7 @@ TYPED_TEST(DirectSumTest, IntegrationConservesLinearMomentumToRoundOff) {
   }
   const double tol = 8 * u * std::sqrt(double(steps)) * (std::sqrt(m2v2) + dt * std::sqrt(double(n) * m2s2));
   GravitySettings g;
-  g.method = Method::direct;
+  g.method = Method::Direct;
   g.softening = eps;
   // 512 particles need no threads (and a busy machine makes many small parallel loops slow).
   const int saved = parallel::thread_count();
@@ -120,7 +120,7 @@ TYPED_TEST(DirectSumTest, IntegrationConservesLinearMomentumToRoundOff) {
   EXPECT_LT(momentum_drift(p, g, dt, steps), tol);
   // A tree's forces are not pairwise symmetric: its momentum error is far
   // larger, which shows the bound can tell.
-  g.method = Method::barnes_hut;
+  g.method = Method::BarnesHut;
   g.opening = 0.7;
   EXPECT_GT(momentum_drift(p, g, dt, steps), 10 * tol);
   parallel::set_thread_count(saved);

@@ -56,7 +56,7 @@ TYPED_TEST(EquilibriumTest, PlummerSphereStaysInEquilibriumForTenCrossingTimes) 
   const int steps = int(std::ceil(10 * kHenonCrossingTime / dt));
   const std::vector<Scheme> schemes = std::is_same_v<Real, double>
                                          ? std::vector<Scheme>(testing::kSchemes.begin(), testing::kSchemes.end())
-                                         : std::vector<Scheme>{Scheme::subtree};
+                                         : std::vector<Scheme>{Scheme::Subtree};
   for (Scheme scheme : schemes) {
     SCOPED_TRACE(to_string(scheme));
     GravitySettings g;

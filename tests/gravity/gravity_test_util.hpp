@@ -17,7 +17,7 @@
 namespace swirl::gravity::testing {
 
 using Precisions = ::testing::Types<float, double>;
-inline constexpr std::array<Scheme, 3> kSchemes{Scheme::subdomain, Scheme::subtree, Scheme::global};
+inline constexpr std::array<Scheme, 3> kSchemes{Scheme::Subdomain, Scheme::Subtree, Scheme::Global};
 
 template <class Real>
 ParticleSet<double> to_double(const ParticleSet<Real>& p) {

@@ -1,5 +1,5 @@
-// The linear octree's group walk (linear_octree.hpp, Walk::group) against its
-// slow twins: the direct sum (θ = 0) and the per-particle walk (Walk::particle)
+// The linear octree's group walk (linear_octree.hpp, Walk::Group) against its
+// slow twins: the direct sum (θ = 0) and the per-particle walk (Walk::Particle)
 // at equal θ. The group's opening test (centre of mass to the group's bounding
 // box) is at least as strict as the per-particle one for every particle of the
 // group, so its interaction lists are refinements of the per-particle ones:
@@ -80,7 +80,7 @@ TYPED_TEST(GroupWalkTest, GroupsCoverEveryParticleOnceInCurveOrder) {
   for (std::size_t group : {std::size_t(1), std::size_t(16), std::size_t(64), std::size_t(5000)}) {
     SCOPED_TRACE(group);
     LinearOctree<Real> tree;
-    tree.build(p, walk_settings(Walk::group, Multipole::quadrupole, Criterion::barnes, 0.5, 8, group), 64);
+    tree.build(p, walk_settings(Walk::Group, Multipole::Quadrupole, Criterion::Barnes, 0.5, 8, group), 64);
     const auto& t = tree.nodes();
     std::uint32_t next = 0;
     for (std::uint32_t g : tree.groups()) {
@@ -122,14 +122,14 @@ TYPED_TEST(GroupWalkTest, OpeningZeroIsTheDirectSum) {
     }
   };
   const bool is_float = std::is_same_v<Real, float>;
-  for (Multipole mp : {Multipole::monopole, Multipole::quadrupole}) {
-    for (Criterion cr : {Criterion::paper, Criterion::barnes}) {
+  for (Multipole mp : {Multipole::Monopole, Multipole::Quadrupole}) {
+    for (Criterion cr : {Criterion::Paper, Criterion::Barnes}) {
       for (std::size_t group : {std::size_t(1), std::size_t(32), std::size_t(64)}) {
         SCOPED_TRACE(std::string(to_string(mp)) + " " + std::string(to_string(cr)) + " group " + std::to_string(group));
-        LinearTreeSettings s = walk_settings(Walk::group, mp, cr, 0.0, 8, group);
+        LinearTreeSettings s = walk_settings(Walk::Group, mp, cr, 0.0, 8, group);
         s.simd_kernels = false;
         check(s, is_float ? 2e-5 : 1e-12);
-        if (mp != Multipole::quadrupole || group != 32) continue;  // the SIMD paths once (quick under ASan)
+        if (mp != Multipole::Quadrupole || group != 32) continue;  // the SIMD paths once (quick under ASan)
         s.simd_kernels = true;
         for (simd::Isa isa : simd::kCompiledIsas) {
           if (!simd::usable(isa)) continue;
@@ -148,24 +148,24 @@ template <class Real>
 void expect_no_worse_than_particle_walk(const ParticleSet<Real>& p, const char* name) {
   GravityField<double> ref;
   direct_sum(testing::to_double(p), 0.01, 64, ref);
-  for (Multipole mp : {Multipole::monopole, Multipole::quadrupole}) {
-    for (Criterion cr : {Criterion::paper, Criterion::barnes}) {
+  for (Multipole mp : {Multipole::Monopole, Multipole::Quadrupole}) {
+    for (Criterion cr : {Criterion::Paper, Criterion::Barnes}) {
       for (double theta : {0.5, 0.8}) {
         SCOPED_TRACE(std::string(name) + " " + std::string(to_string(mp)) + " " + std::string(to_string(cr)) +
                      " theta " + std::to_string(theta));
         std::vector<double> err[2];
         WalkCounts counts[2];
-        for (Walk walk : {Walk::particle, Walk::group}) {
+        for (Walk walk : {Walk::Particle, Walk::Group}) {
           LinearOctree<Real> tree;
           tree.build(p, walk_settings(walk, mp, cr, theta), 64);
           GravityField<Real> f;
           counts[std::size_t(walk)] = tree.evaluate(f, 64);
           err[std::size_t(walk)] = errors_of(f, ref);
         }
-        const auto& g = err[std::size_t(Walk::group)];
-        const auto& q = err[std::size_t(Walk::particle)];
-        const WalkCounts& cg = counts[std::size_t(Walk::group)];
-        const WalkCounts& cq = counts[std::size_t(Walk::particle)];
+        const auto& g = err[std::size_t(Walk::Group)];
+        const auto& q = err[std::size_t(Walk::Particle)];
+        const WalkCounts& cg = counts[std::size_t(Walk::Group)];
+        const WalkCounts& cq = counts[std::size_t(Walk::Particle)];
         EXPECT_GE(cg.pairs + cg.multipoles, cq.pairs + cq.multipoles);
         EXPECT_GE(cg.pairs, cq.pairs);
         // Round-off of the sums (float: the kernels' 1/sqrt as well).
@@ -218,7 +218,7 @@ TYPED_TEST(GroupWalkTest, BitIdenticalForOneTwoAndThreeThreadsAndAnyOrder) {
     SCOPED_TRACE(threads);
     parallel::set_thread_count(threads);
     LinearOctree<Real> tree;
-    tree.build(p, walk_settings(Walk::group, Multipole::quadrupole, Criterion::barnes, 0.6, 16, 32), 256);
+    tree.build(p, walk_settings(Walk::Group, Multipole::Quadrupole, Criterion::Barnes, 0.6, 16, 32), 256);
     GravityField<Real> first, second, rebuilt;
     counts.push_back(tree.evaluate(first, 256));
     const std::vector<std::uint32_t> schedule1(tree.group_schedule().begin(), tree.group_schedule().end());
@@ -254,7 +254,7 @@ TYPED_TEST(GroupWalkTest, BitIdenticalForOneTwoAndThreeThreadsAndAnyOrder) {
 TYPED_TEST(GroupWalkTest, SimdKernelsMatchTheScalarPathThroughTheWalk) {
   using Real = TypeParam;
   const ParticleSet<Real> p = plummer<Real>(4000, 3);
-  LinearTreeSettings s = walk_settings(Walk::group, Multipole::quadrupole, Criterion::barnes, 0.7);
+  LinearTreeSettings s = walk_settings(Walk::Group, Multipole::Quadrupole, Criterion::Barnes, 0.7);
   s.simd_kernels = false;
   LinearOctree<Real> scalar_tree;
   scalar_tree.build(p, s, 64);
@@ -284,9 +284,9 @@ TYPED_TEST(GroupWalkTest, SimdKernelsMatchTheScalarPathThroughTheWalk) {
 }
 
 TEST(GroupWalkSettings, WalkNamesParseAndBadNamesAreRefused) {
-  EXPECT_EQ(parse_walk("group"), Walk::group);
-  EXPECT_EQ(parse_walk("particle"), Walk::particle);
-  EXPECT_EQ(to_string(Walk::group), "group");
+  EXPECT_EQ(parse_walk("group"), Walk::Group);
+  EXPECT_EQ(parse_walk("particle"), Walk::Particle);
+  EXPECT_EQ(to_string(Walk::Group), "group");
   try {
     parse_walk("per-group");
     FAIL() << "no error";
@@ -295,7 +295,7 @@ TEST(GroupWalkSettings, WalkNamesParseAndBadNamesAreRefused) {
     EXPECT_NE(std::string(e.what()).find("particle"), std::string::npos);
   }
   GravitySettings g;
-  EXPECT_EQ(g.walk, Walk::group);
+  EXPECT_EQ(g.walk, Walk::Group);
   g.group_size = 0;
   EXPECT_THROW(validate(g), std::invalid_argument);
   LinearOctree<double> tree;

@@ -177,13 +177,13 @@ template <class Real>
 void check_simd_against_scalar(Kind kind, const Sources<Real>& s, const Group<Real>& g, Real eps2,
                                std::size_t self_offset = SourceParticles<Real>::npos) {
   Group<Real> scalar = g;
-  apply(kind, s, scalar, eps2, KernelPath::scalar, self_offset);
+  apply(kind, s, scalar, eps2, KernelPath::Scalar, self_offset);
   expect_finite(scalar, "scalar");
   const Scale sc = term_scale(s, g, double(eps2), kind == Kind::quadrupole);
   for (simd::Isa isa : usable_isas()) {
     simd::ScopedIsa scope(isa);
     Group<Real> fast = g;
-    apply(kind, s, fast, eps2, KernelPath::simd, self_offset);
+    apply(kind, s, fast, eps2, KernelPath::Simd, self_offset);
     const std::string what = describe(kind, isa, s.size(), g.size());
     expect_finite(fast, what);
     expect_close(fast, scalar, sc, kTolerance<Real>, what);
@@ -240,7 +240,7 @@ TYPED_TEST(InteractionKernels, SelfOffsetSkipsTheTargetsOwnPairs) {
           check_simd_against_scalar(Kind::particles, s, g, eps2, before);
           // The scalar path against the pair law, self pairs left out by hand.
           Group<Real> got = g;
-          apply(Kind::particles, s, got, eps2, KernelPath::scalar, before);
+          apply(Kind::particles, s, got, eps2, KernelPath::Scalar, before);
           const Scale sc = term_scale(s, g, double(eps2), false);
           for (std::size_t i = 0; i < nt; ++i) {
             Accumulator<Real> acc;
@@ -263,7 +263,7 @@ TYPED_TEST(InteractionKernels, SelfPairWouldCountWithoutSelfOffset) {
   const Sources<Real> s = random_sources<Real>(9, rng);
   const Group<Real> g = group_of(s, 2, 5, rng);
   const Real eps = Real(0.1);
-  for (KernelPath path : {KernelPath::scalar, KernelPath::simd}) {
+  for (KernelPath path : {KernelPath::Scalar, KernelPath::Simd}) {
     Group<Real> with = g, without = g;
     apply(Kind::particles, s, with, eps * eps, path, 2);
     apply(Kind::particles, s, without, eps * eps, path);
@@ -288,7 +288,7 @@ TYPED_TEST(InteractionKernels, ZeroSeparationWithSoftening) {
   one.y[0] = t.y[0];
   one.z[0] = t.z[0];
   for (Kind kind : kKinds)
-    for (KernelPath path : {KernelPath::scalar, KernelPath::simd}) {
+    for (KernelPath path : {KernelPath::Scalar, KernelPath::Simd}) {
       Group<Real> got = t;
       apply(kind, one, got, eps * eps, path);
       EXPECT_EQ(got.ax[0], t.ax[0]);
@@ -306,7 +306,7 @@ TYPED_TEST(InteractionKernels, CoincidentPairWithoutSofteningContributesNothing)
   for (Kind kind : kKinds) {
     check_simd_against_scalar(kind, s, g, Real(0));
     // Equal to the same sum without the coincident sources, per target.
-    for (KernelPath path : {KernelPath::scalar, KernelPath::simd}) {
+    for (KernelPath path : {KernelPath::Scalar, KernelPath::Simd}) {
       Group<Real> got = g;
       apply(kind, s, got, Real(0), path);
       for (std::size_t i = 0; i < g.size(); ++i) {
@@ -318,7 +318,7 @@ TYPED_TEST(InteractionKernels, CoincidentPairWithoutSofteningContributesNothing)
                                 {&one.ay, &g.ay}, {&one.az, &g.az}, {&one.phi, &g.phi}})
           to->push_back((*from)[i]);
         const Scale sc = term_scale(rest, one, 0, kind == Kind::quadrupole);
-        apply(kind, rest, one, Real(0), KernelPath::scalar);
+        apply(kind, rest, one, Real(0), KernelPath::Scalar);
         const double tol = kTolerance<Real>;
         ASSERT_NEAR(double(got.ax[i]), double(one.ax[0]), tol * sc.accel[0]) << i;
         ASSERT_NEAR(double(got.ay[i]), double(one.ay[0]), tol * sc.accel[0]) << i;
@@ -393,9 +393,9 @@ TYPED_TEST(InteractionKernels, QuadrupoleApproximatesTheDirectSumOfACluster) {
   for (std::size_t i = 0; i < g.size(); ++i) g.ax[i] = g.ay[i] = g.az[i] = g.phi[i] = 0;
   const Real eps2 = Real(1e-4);
   Group<Real> direct = g, mono = g, quad = g;
-  add_particle_field(points.particles(), direct.targets(), eps2, KernelPath::scalar);
-  add_cell_field(cell.cells(), mono.targets(), eps2, false, KernelPath::scalar);
-  add_cell_field(cell.cells(), quad.targets(), eps2, true, KernelPath::scalar);
+  add_particle_field(points.particles(), direct.targets(), eps2, KernelPath::Scalar);
+  add_cell_field(cell.cells(), mono.targets(), eps2, false, KernelPath::Scalar);
+  add_cell_field(cell.cells(), quad.targets(), eps2, true, KernelPath::Scalar);
   double worst_mono = 0, worst_quad = 0;
   for (std::size_t i = 0; i < g.size(); ++i) {
     const double norm = std::hypot(double(direct.ax[i]), double(direct.ay[i]), double(direct.az[i]));
@@ -422,7 +422,7 @@ TEST(InteractionKernelsDouble, AccelerationIsMinusTheGradientOfThePotential) {
       Group<double> g = random_group<double>(10, rng);
       for (std::size_t i = 0; i < g.size(); ++i) g.ax[i] = g.ay[i] = g.az[i] = g.phi[i] = 0;
       Group<double> field = g;
-      add_cell_field(s.cells(), field.targets(), eps2, quadrupole, KernelPath::scalar);
+      add_cell_field(s.cells(), field.targets(), eps2, quadrupole, KernelPath::Scalar);
       const double h = 1e-5;
       for (std::size_t i = 0; i < g.size(); ++i) {
         const double a[3] = {field.ax[i], field.ay[i], field.az[i]};
@@ -433,7 +433,7 @@ TEST(InteractionKernelsDouble, AccelerationIsMinusTheGradientOfThePotential) {
             Group<double> p = g;
             std::vector<double>& coordinate = axis == 0 ? p.x : axis == 1 ? p.y : p.z;
             coordinate[i] += side == 0 ? h : -h;
-            add_cell_field(s.cells(), p.targets(), eps2, quadrupole, KernelPath::scalar);
+            add_cell_field(s.cells(), p.targets(), eps2, quadrupole, KernelPath::Scalar);
             phi[side] = p.phi[i];
           }
           const double gradient = (phi[0] - phi[1]) / (2 * h);
@@ -453,7 +453,7 @@ TYPED_TEST(InteractionKernels, ScalarParticlesAreThePairLaw) {
   const Group<Real> g = random_group<Real>(9, rng);
   const Real eps2 = Real(1e-2);
   Group<Real> got = g;
-  add_particle_field(s.particles(), got.targets(), eps2, KernelPath::scalar);
+  add_particle_field(s.particles(), got.targets(), eps2, KernelPath::Scalar);
   const Scale sc = term_scale(s, g, double(eps2), false);
   for (std::size_t i = 0; i < g.size(); ++i) {
     double ax = g.ax[i], ay = g.ay[i], az = g.az[i], phi = g.phi[i];
@@ -499,7 +499,7 @@ TYPED_TEST(InteractionKernels, SimdTermsAreAccurateAtEveryDistance) {
     simd::ScopedIsa scope(isa);
     for (Kind kind : kKinds) {
       Group<Real> got = g;
-      apply(kind, one, got, Real(eps2), KernelPath::simd);
+      apply(kind, one, got, Real(eps2), KernelPath::Simd);
       for (std::size_t i = 0; i < g.size(); ++i) {
         const double dx = -double(g.x[i]), dy = -double(g.y[i]), dz = -double(g.z[i]);
         const PairTerm<double> t = pair_term(dx, dy, dz, double(one.m[0]), eps2);
@@ -522,7 +522,7 @@ TYPED_TEST(InteractionKernels, EmptyListsAreNoOps) {
   const Sources<Real> s = random_sources<Real>(5, rng);
   Group<Real> g = random_group<Real>(3, rng);
   const Group<Real> before = g;
-  for (KernelPath path : {KernelPath::scalar, KernelPath::simd}) {
+  for (KernelPath path : {KernelPath::Scalar, KernelPath::Simd}) {
     add_particle_field(s.particles(), none, Real(0), path);
     add_cell_field(s.cells(), none, Real(0), true, path);
     add_particle_field(SourceParticles<Real>{nullptr, nullptr, nullptr, nullptr, 0}, g.targets(), Real(0), path);

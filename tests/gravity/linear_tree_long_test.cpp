@@ -65,11 +65,11 @@ TYPED_TEST(LinearTreeEnergyTest, PlummerSphereConservesEnergyAsWellAsTheBaseline
   GravitySettings linear;
   linear.opening = 0.5;
   linear.softening = 0.05;
-  ASSERT_EQ(linear.tree, Tree::linear);
-  ASSERT_EQ(linear.multipole, Multipole::quadrupole);
-  ASSERT_EQ(linear.criterion, Criterion::barnes);
+  ASSERT_EQ(linear.tree, Tree::Linear);
+  ASSERT_EQ(linear.multipole, Multipole::Quadrupole);
+  ASSERT_EQ(linear.criterion, Criterion::Barnes);
   GravitySettings paper = linear;
-  paper.tree = Tree::paper;
+  paper.tree = Tree::Paper;
   const Outcome l = run<Real>(linear);
   const Outcome p = run<Real>(paper);
   this->RecordProperty("linear_energy_error", std::to_string(l.worst_energy));

@@ -41,7 +41,7 @@ TYPED_TEST_SUITE(LinearTreeTest, testing::Precisions);
 LinearTreeSettings tree_settings(Multipole multipole, Criterion criterion, double opening, double eps,
                                  std::size_t bucket = 16) {
   LinearTreeSettings s;
-  s.walk = Walk::particle;  // these are the per-particle walk's tests; group_walk_test.cpp tests the group walk
+  s.walk = Walk::Particle;  // these are the per-particle walk's tests; group_walk_test.cpp tests the group walk
   s.multipole = multipole;
   s.criterion = criterion;
   s.opening = opening;
@@ -146,7 +146,7 @@ TYPED_TEST(LinearTreeTest, TreeInvariantsHoldForEveryBucketSize) {
   for (std::size_t bucket : {std::size_t(1), std::size_t(8), std::size_t(64)}) {
     SCOPED_TRACE(bucket);
     LinearOctree<Real> tree;
-    tree.build(p, tree_settings(Multipole::quadrupole, Criterion::barnes, 0.5, 0.01, bucket), 100);
+    tree.build(p, tree_settings(Multipole::Quadrupole, Criterion::Barnes, 0.5, 0.01, bucket), 100);
     check_invariants(tree, p, bucket);
     EXPECT_EQ(tree.depth(), LinearOctree<Real>::kLevels);  // the coincident clump reaches the finest level
   }
@@ -159,8 +159,8 @@ TYPED_TEST(LinearTreeTest, OpeningZeroIsTheDirectSum) {
   GravityField<Real> direct;
   direct_sum(p, Real(eps), 64, direct);
   const double tol = std::is_same_v<Real, float> ? 2e-5 : 1e-12;
-  for (Multipole mp : {Multipole::monopole, Multipole::quadrupole}) {
-    for (Criterion cr : {Criterion::paper, Criterion::barnes}) {
+  for (Multipole mp : {Multipole::Monopole, Multipole::Quadrupole}) {
+    for (Criterion cr : {Criterion::Paper, Criterion::Barnes}) {
       LinearOctree<Real> tree;
       tree.build(p, tree_settings(mp, cr, 0.0, eps, 8), 64);
       GravityField<Real> f;
@@ -191,9 +191,9 @@ TYPED_TEST(LinearTreeTest, QuadrupoleIsMoreAccurateThanMonopoleAtEqualTheta) {
   for (double theta : {0.5, 0.7}) {
     std::array<std::vector<double>, 2> errors;
     std::array<double, 2> potential_error{};
-    for (Multipole mp : {Multipole::monopole, Multipole::quadrupole}) {
+    for (Multipole mp : {Multipole::Monopole, Multipole::Quadrupole}) {
       LinearOctree<Real> tree;
-      tree.build(p, tree_settings(mp, Criterion::barnes, theta, eps), 64);
+      tree.build(p, tree_settings(mp, Criterion::Barnes, theta, eps), 64);
       GravityField<Real> f;
       tree.evaluate(f, 64);
       errors[std::size_t(mp)] = testing::relative_errors(f, ref, ref);
@@ -268,10 +268,10 @@ TYPED_TEST(LinearTreeTest, PaperRuleFailsOnAClumpAtACellCornerBarnesRuleDoesNot)
     }
     return std::sqrt(d2 / r2);
   };
-  for (Multipole mp : {Multipole::monopole, Multipole::quadrupole}) {
+  for (Multipole mp : {Multipole::Monopole, Multipole::Quadrupole}) {
     SCOPED_TRACE(to_string(mp));
-    EXPECT_GT(error_of(mp, Criterion::paper), 0.10);
-    EXPECT_LT(error_of(mp, Criterion::barnes), 0.01);
+    EXPECT_GT(error_of(mp, Criterion::Paper), 0.10);
+    EXPECT_LT(error_of(mp, Criterion::Barnes), 0.01);
   }
 }
 
@@ -286,7 +286,7 @@ TYPED_TEST(LinearTreeTest, BitIdenticalForOneTwoAndThreeThreads) {
   for (int threads : {1, 2, 3}) {
     parallel::set_thread_count(threads);
     LinearOctree<Real> tree;
-    tree.build(p, tree_settings(Multipole::quadrupole, Criterion::barnes, 0.6, 0.01), 256);
+    tree.build(p, tree_settings(Multipole::Quadrupole, Criterion::Barnes, 0.6, 0.01), 256);
     GravityField<Real> f;
     counts.push_back(tree.evaluate(f, 256));
     fields.push_back(std::move(f));
@@ -316,7 +316,7 @@ TYPED_TEST(LinearTreeTest, TheSolverViewsTheSharedOrderAndIdsSurvive) {
   using Real = TypeParam;
   const ParticleSet<Real> p = plummer<Real>(3000, 5);
   GravitySettings g;  // the default: global scheme, linear tree, quadrupole, Barnes' rule
-  ASSERT_EQ(g.tree, Tree::linear);
+  ASSERT_EQ(g.tree, Tree::Linear);
   // The field the tree computes without moving the particles...
   BarnesHut<Real> still(g);
   GravityField<Real> expected;

@@ -68,26 +68,26 @@ TYPED_TEST(ParametersTest, ZeroSizes) {
 }
 
 TEST(ParametersTest, TreeMultipoleAndCriterionNamesRoundTrip) {
-  for (Tree t : {Tree::paper, Tree::linear}) EXPECT_EQ(parse_tree(to_string(t)), t);
-  for (Multipole m : {Multipole::monopole, Multipole::quadrupole}) EXPECT_EQ(parse_multipole(to_string(m)), m);
-  for (Criterion c : {Criterion::paper, Criterion::barnes}) EXPECT_EQ(parse_criterion(to_string(c)), c);
+  for (Tree t : {Tree::Paper, Tree::Linear}) EXPECT_EQ(parse_tree(to_string(t)), t);
+  for (Multipole m : {Multipole::Monopole, Multipole::Quadrupole}) EXPECT_EQ(parse_multipole(to_string(m)), m);
+  for (Criterion c : {Criterion::Paper, Criterion::Barnes}) EXPECT_EQ(parse_criterion(to_string(c)), c);
   expect_invalid([] { (void)parse_tree("kd"); }, {"tree", "kd", "\"paper\"", "\"linear\""});
   expect_invalid([] { (void)parse_multipole("octupole"); }, {"octupole", "\"monopole\"", "\"quadrupole\""});
   expect_invalid([] { (void)parse_criterion("bmax"); }, {"bmax", "\"paper\"", "\"barnes\""});
   // The defaults of the issue: the linear tree, quadrupoles, Barnes' rule.
   const GravitySettings s;
-  EXPECT_EQ(s.scheme, Scheme::global);
-  EXPECT_EQ(s.tree, Tree::linear);
-  EXPECT_EQ(s.multipole, Multipole::quadrupole);
-  EXPECT_EQ(s.criterion, Criterion::barnes);
+  EXPECT_EQ(s.scheme, Scheme::Global);
+  EXPECT_EQ(s.tree, Tree::Linear);
+  EXPECT_EQ(s.multipole, Multipole::Quadrupole);
+  EXPECT_EQ(s.criterion, Criterion::Barnes);
 }
 
 TEST(ParametersTest, UnknownSchemeOrMethodListsTheAllowedNames) {
   expect_invalid([] { (void)parse_scheme("quadtree"); }, {"quadtree", "\"subdomain\"", "\"subtree\"", "\"global\""});
   expect_invalid([] { (void)parse_method("fmm"); }, {"fmm", "\"direct\"", "\"barnes_hut\""});
   for (Scheme s : testing::kSchemes) EXPECT_EQ(parse_scheme(to_string(s)), s);
-  EXPECT_EQ(parse_method("direct"), Method::direct);
-  EXPECT_EQ(parse_method("barnes_hut"), Method::barnes_hut);
+  EXPECT_EQ(parse_method("direct"), Method::Direct);
+  EXPECT_EQ(parse_method("barnes_hut"), Method::BarnesHut);
 }
 
 TYPED_TEST(ParametersTest, NoParticlesOrBadShapesForInitialConditions) {

@@ -28,7 +28,7 @@ TYPED_TEST_SUITE(SchemesTest, testing::Precisions);
 GravitySettings settings(Scheme scheme, double lambda, double eps, bool small) {
   GravitySettings s;
   s.scheme = scheme;
-  s.tree = Tree::paper;  // the paper's schemes and tree; the linear tree: linear_tree_test.cpp
+  s.tree = Tree::Paper;  // the paper's schemes and tree; the linear tree: linear_tree_test.cpp
   s.opening = lambda;
   s.softening = eps;
   if (small) {
@@ -79,7 +79,7 @@ TYPED_TEST(SchemesTest, LambdaZeroIsTheDirectSumToRoundOff) {
 TYPED_TEST(SchemesTest, LambdaZeroVisitsEveryNodeOfTheGlobalTree) {
   using Real = TypeParam;
   const ParticleSet<Real> p = plummer<Real>(500, 3);
-  BarnesHut<Real> tree(settings(Scheme::global, 0.0, 0.01, false));
+  BarnesHut<Real> tree(settings(Scheme::Global, 0.0, 0.01, false));
   GravityField<Real> f;
   tree.compute(p, f, 64);
   EXPECT_EQ(tree.stats().mean_nodes_visited, double(tree.stats().nodes));
@@ -113,13 +113,13 @@ TYPED_TEST(SchemesTest, ADistantProbeFeelsEveryMassExactlyOnce) {
 TYPED_TEST(SchemesTest, OneUnitHoldingTheWholeTreeIsTheGlobalWalk) {
   using Real = TypeParam;
   const ParticleSet<Real> p = plummer<Real>(1500, 5);
-  GravitySettings s = settings(Scheme::subtree, 0.6, 0.01, false);
+  GravitySettings s = settings(Scheme::Subtree, 0.6, 0.01, false);
   s.subtree_nodes = 1u << 30;
   const auto one_unit = testing::tree_field(p, s);
-  s.scheme = Scheme::global;
+  s.scheme = Scheme::Global;
   EXPECT_TRUE(testing::same_bits(one_unit, testing::tree_field(p, s)));
   // ... and units of the paper's size change the sums (the test can tell).
-  s.scheme = Scheme::subtree;
+  s.scheme = Scheme::Subtree;
   s.subtree_nodes = 370;
   EXPECT_FALSE(testing::same_bits(one_unit, testing::tree_field(p, s)));
 }
@@ -137,9 +137,9 @@ TYPED_TEST(SchemesTest, SubdomainsAndUnitsRespectTheirSizesAndCountTheirWork) {
     const auto work = tree.work();
     ASSERT_EQ(work.size(), st.trees);
     EXPECT_DOUBLE_EQ(double(std::accumulate(work.begin(), work.end(), std::uint64_t(0))), st.mean_nodes_visited * n);
-    if (scheme == Scheme::subdomain) {
+    if (scheme == Scheme::Subdomain) {
       EXPECT_GE(st.trees, (n + 207) / 208);  // runs of ≤ 208 particles
-    } else if (scheme == Scheme::subtree) {
+    } else if (scheme == Scheme::Subtree) {
       EXPECT_GE(st.trees, (st.nodes + 369) / 370);  // units of ≤ 370 nodes
     } else {
       EXPECT_EQ(st.trees, 1u);

@@ -38,8 +38,8 @@ std::string error_of(const std::string& text, std::vector<std::string> overrides
 TEST(NbodyScene, PlummerSceneParsesIntoOpenSpaceInDouble) {
   const Scene s = parse_scene(kPlummer, "g.toml");
   ASSERT_TRUE(s.nbody);
-  EXPECT_EQ(s.nbody->scheme, swirl::gravity::Scheme::subtree);
-  EXPECT_EQ(s.nbody->method, swirl::gravity::Method::barnes_hut);
+  EXPECT_EQ(s.nbody->scheme, swirl::gravity::Scheme::Subtree);
+  EXPECT_EQ(s.nbody->method, swirl::gravity::Method::BarnesHut);
   EXPECT_EQ(s.nbody->opening, 0.7);
   EXPECT_EQ(s.nbody->softening, 0.02);
   EXPECT_EQ(s.nbody->subdomain_size, 208u);

@@ -84,7 +84,7 @@ TEST(Validate, AppliesTheRulesBetweenKeys) {
   EXPECT_EQ(refusal(s), "scene: particles[0].masses[0]: must be > 0, got 0");
   s = small_scene();
   s.nbody.emplace();
-  s.nbody->scheme = gravity::Scheme::subtree;  // the linear tree needs the global scheme
+  s.nbody->scheme = gravity::Scheme::Subtree;  // the linear tree needs the global scheme
   EXPECT_EQ(refusal(s), "scene: nbody.tree: \"linear\" needs nbody.scheme = \"global\" (the paper's scheme "
                         "\"subtree\" walks the paper's tree)");
   s = small_scene();

@@ -15,14 +15,14 @@ const std::string kNbody = test::kMinimalScene + "\n[nbody]\nopening = 0.5\n";
 TEST(WalkKeys, DefaultsAreTheGroupWalkOfTheLinearTree) {
   const Scene s = parse_scene(kNbody, "scene.toml");
   ASSERT_TRUE(s.nbody);
-  EXPECT_EQ(s.nbody->walk, gravity::Walk::group);
+  EXPECT_EQ(s.nbody->walk, gravity::Walk::Group);
   EXPECT_EQ(s.nbody->group_size, 256u);
 }
 
 TEST(WalkKeys, ReadsWalkAndGroupSize) {
   const Scene s = parse_scene(kNbody + "walk = \"particle\"\ngroup_size = 64\n", "scene.toml");
   ASSERT_TRUE(s.nbody);
-  EXPECT_EQ(s.nbody->walk, gravity::Walk::particle);
+  EXPECT_EQ(s.nbody->walk, gravity::Walk::Particle);
   EXPECT_EQ(s.nbody->group_size, 64u);
   const Scene o = parse_scene(kNbody, "scene.toml", std::vector<std::string>{"nbody.group_size=512"});
   EXPECT_EQ(o.nbody->group_size, 512u);

@@ -41,7 +41,7 @@ struct Settled {
 Settled settle_sphere() {
   using Real = double;
   const double s = 0.1, rho0 = 1, c = 10;
-  const double h = sph::smoothing_length_for_neighbors(30, s * s * s);
+  const double h = sph::smoothing_length_for_neighbours(30, s * s * s);
   auto p = swirl::testing::lattice_fluid<Real>({-1, -1, -1}, {1, 1, 1}, s, h, rho0,
                                         [](const Vec3d& x) { return x.x * x.x + x.y * x.y + x.z * x.z <= 1.0; });
   double mass = 0;

@@ -37,7 +37,7 @@ TEST(SimdLanes, ActiveIsTheWidestTheCpuRunsUnlessChosen) {
 }
 
 TEST(SimdLanes, UnusableCopiesAreRefused) {
-  for (simd::Isa isa : {simd::Isa::generic, simd::Isa::sse2, simd::Isa::avx2, simd::Isa::avx512})
+  for (simd::Isa isa : {simd::Isa::Generic, simd::Isa::Sse2, simd::Isa::Avx2, simd::Isa::Avx512})
     if (!simd::usable(isa)) {
       EXPECT_THROW(simd_float_lanes(isa), std::invalid_argument);
       EXPECT_THROW(simd::set_active(isa), std::invalid_argument);

@@ -39,21 +39,21 @@ ParticleSet<Real> random_particles(std::size_t n, double lo, double side, std::u
 }
 
 template <class Real>
-Pairs pairs_of(const NeighborList<Real>& l) {
+Pairs pairs_of(const NeighbourList<Real>& l) {
   Pairs pairs;
   for (std::size_t row = 0; row < l.rows(); ++row)
-    for (std::size_t k = l.offsets[row]; k < l.offsets[row + 1]; ++k) pairs.emplace_back(l.row_particle[row], l.neighbor[k]);
+    for (std::size_t k = l.offsets[row]; k < l.offsets[row + 1]; ++k) pairs.emplace_back(l.row_particle[row], l.neighbour[k]);
   std::sort(pairs.begin(), pairs.end());
   return pairs;
 }
 
 template <class Real>
-NeighborList<Real> search(const ParticleSet<Real>& p, Real h, std::uint32_t buckets, bool check,
+NeighbourList<Real> search(const ParticleSet<Real>& p, Real h, std::uint32_t buckets, bool check,
                           SearchCounters* counters = nullptr, std::size_t block_size = 37) {
   SpatialHash<Real> hash;
   hash.build(p, h, buckets, block_size);
-  NeighborList<Real> lists;
-  hash.find_neighbors(p, check, block_size, lists, [](auto, auto, auto, auto) {}, counters);
+  NeighbourList<Real> lists;
+  hash.find_neighbours(p, check, block_size, lists, [](auto, auto, auto, auto) {}, counters);
   return lists;
 }
 
@@ -73,7 +73,7 @@ TYPED_TEST(SpatialHashTest, WithTheCheckOnTheListsAreExactlyTheBruteForcePairs) 
     // r² is stored exactly as the shared distance function computes it.
     for (std::size_t row = 0; row < lists.rows(); ++row)
       for (std::size_t k = lists.offsets[row]; k < lists.offsets[row + 1]; ++k) {
-        const auto i = lists.row_particle[row], j = lists.neighbor[k];
+        const auto i = lists.row_particle[row], j = lists.neighbour[k];
         ASSERT_EQ(lists.r2[k], distance2(p.position.x[i], p.position.y[i], p.position.z[i], p.position.x[j],
                                          p.position.y[j], p.position.z[j]));
       }
@@ -163,7 +163,7 @@ TYPED_TEST(SpatialHashTest, ListsAreIdenticalForAnyThreadCount) {
     const auto other = with(t);
     EXPECT_EQ(other.row_particle, one.row_particle);
     EXPECT_EQ(other.offsets, one.offsets);
-    EXPECT_EQ(other.neighbor, one.neighbor);
+    EXPECT_EQ(other.neighbour, one.neighbour);
     EXPECT_EQ(other.r2, one.r2);
   }
 }

@@ -54,7 +54,7 @@ struct Box {
 
   static sph::SphParameters parameters() {
     sph::SphParameters s;
-    s.smoothing_length = sph::smoothing_length_for_neighbors(25, 1.0 / double(kParticles));
+    s.smoothing_length = sph::smoothing_length_for_neighbours(25, 1.0 / double(kParticles));
     s.rest_density = 1000;
     s.sound_speed = 1;
     s.viscosity = 0.05;
@@ -92,7 +92,7 @@ Result<Real> evaluate(const Box<Real>& box, const Result<Real>* reference = null
   ParticleSet<Real> p = box.p;
   sph::GridScratch<Real> scratch;
   Result<Real> r;
-  r.pairs = sph::grid_density<Real, Simd>(box.fluid.grid(), p, box.k, kBlock, scratch);
+  r.pairs = sph::grid_density(box.fluid.grid(), p, box.k, kBlock, scratch, Simd ? KernelPath::Simd : KernelPath::Scalar);
   r.density.assign(p.density.begin(), p.density.end());
   r.pressure.assign(p.pressure.begin(), p.pressure.end());
   if (reference) {
@@ -106,7 +106,7 @@ Result<Real> evaluate(const Box<Real>& box, const Result<Real>* reference = null
   std::fill(p.acceleration.x.begin(), p.acceleration.x.end(), Real(0));
   std::fill(p.acceleration.y.begin(), p.acceleration.y.end(), Real(0));
   std::fill(p.acceleration.z.begin(), p.acceleration.z.end(), Real(0));
-  sph::grid_forces<Real, Simd>(box.fluid.grid(), p, box.k, kBlock, scratch);
+  sph::grid_forces(box.fluid.grid(), p, box.k, kBlock, scratch, Simd ? KernelPath::Simd : KernelPath::Scalar);
   r.ax.assign(p.acceleration.x.begin(), p.acceleration.x.end());
   r.ay.assign(p.acceleration.y.begin(), p.acceleration.y.end());
   r.az.assign(p.acceleration.z.begin(), p.acceleration.z.end());

@@ -27,7 +27,7 @@ struct Setup {
 template <class Real>
 std::unique_ptr<Simulation<Real>> make_box(const Setup& s, double* h_out = nullptr) {
   const double rho0 = 1000;
-  const double h = sph::smoothing_length_for_neighbors(25, 1.0 / double(s.n));
+  const double h = sph::smoothing_length_for_neighbours(25, 1.0 / double(s.n));
   ParticleSet<Real> p(s.n);
   SplitMix64 rng(91);
   for (std::size_t i = 0; i < s.n; ++i) {
@@ -81,7 +81,7 @@ TYPED_TEST(GridSkinTest, EveryStepFindsTheBruteForcePairs) {
         sim->step();
         const auto& p = sim->particles();
         const auto pairs = spatial::brute_force_pairs(p, Real(h));
-        const double found = fluid_of(*sim).mean_neighbors() * double(p.size());
+        const double found = fluid_of(*sim).mean_neighbours() * double(p.size());
         ASSERT_EQ(std::llround(found), static_cast<long long>(pairs.size()))
             << "step " << k << ", skin " << skin << ", morton " << (order == spatial::CellOrder::Morton);
       }

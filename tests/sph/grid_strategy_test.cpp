@@ -28,7 +28,7 @@ struct Setup {
 template <class Real>
 std::unique_ptr<Simulation<Real>> make_random_box(const Setup& s) {
   const double side = 1.0, rho0 = 1000;
-  const double h = sph::smoothing_length_for_neighbors(25, side * side * side / double(s.n));
+  const double h = sph::smoothing_length_for_neighbours(25, side * side * side / double(s.n));
   ParticleSet<Real> p(s.n);
   SplitMix64 rng(77);
   for (std::size_t i = 0; i < s.n; ++i) {
@@ -200,8 +200,8 @@ TYPED_TEST(GridStrategyTest, FarSpreadFallsBackToTheHash) {
     EXPECT_NEAR(q.density[at[r.id[i]]], rho, tol * std::abs(rho));
     EXPECT_NEAR(q.acceleration.x[at[r.id[i]]], ax, tol * (std::abs(ax) + 1));
   }
-  EXPECT_EQ(grid.mean_neighbors(), hash.mean_neighbors());
-  EXPECT_GT(grid.mean_neighbors(), 0.0);
+  EXPECT_EQ(grid.mean_neighbours(), hash.mean_neighbours());
+  EXPECT_GT(grid.mean_neighbours(), 0.0);
 }
 
 }  // namespace

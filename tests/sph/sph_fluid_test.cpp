@@ -54,7 +54,7 @@ TYPED_TEST(SphFluidTest, InteriorLatticeDensityIsTheRestDensity) {
   }
   EXPECT_GT(interior, 500u);
   EXPECT_GT(deep_count, 100u);
-  EXPECT_NEAR(fluid.mean_neighbors(), 32.0 * 0.99, 8.0);  // 32 lattice neighbours within 2.1 s, fewer at faces
+  EXPECT_NEAR(fluid.mean_neighbours(), 32.0 * 0.99, 8.0);  // 32 lattice neighbours within 2.1 s, fewer at faces
 }
 
 TYPED_TEST(SphFluidTest, PairForcesConserveMomentum) {
@@ -76,7 +76,7 @@ TYPED_TEST(SphFluidTest, PairForcesConserveMomentum) {
   params.viscosity = 0.5;
   sph::SphFluid<Real> fluid(params);
   swirl::evaluate_alone(fluid, p, 100);
-  EXPECT_GT(fluid.mean_neighbors(), 5.0);
+  EXPECT_GT(fluid.mean_neighbours(), 5.0);
   for (int a = 0; a < 3; ++a) {
     double sum = 0, magnitude = 0;
     for (std::size_t i = 0; i < n; ++i) {

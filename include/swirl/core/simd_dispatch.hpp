@@ -38,22 +38,22 @@
 
 namespace swirl::simd {
 
-enum class Isa { generic, sse2, avx2, avx512 };
+enum class Isa { Generic, Sse2, Avx2, Avx512 };
 
 #if defined(__x86_64__) || defined(_M_X64)
 #define SWIRL_SIMD_FOR_EACH_NS(X) X(isa_sse2) X(isa_avx2) X(isa_avx512)
-inline constexpr std::array<Isa, 3> kCompiledIsas{Isa::sse2, Isa::avx2, Isa::avx512};
+inline constexpr std::array<Isa, 3> kCompiledIsas{Isa::Sse2, Isa::Avx2, Isa::Avx512};
 #else
 #define SWIRL_SIMD_FOR_EACH_NS(X) X(isa_generic)
-inline constexpr std::array<Isa, 1> kCompiledIsas{Isa::generic};
+inline constexpr std::array<Isa, 1> kCompiledIsas{Isa::Generic};
 #endif
 
 constexpr std::string_view isa_name(Isa isa) {
   switch (isa) {
-    case Isa::generic: return "generic";
-    case Isa::sse2: return "sse2";
-    case Isa::avx2: return "avx2";
-    case Isa::avx512: return "avx512";
+    case Isa::Generic: return "generic";
+    case Isa::Sse2: return "sse2";
+    case Isa::Avx2: return "avx2";
+    case Isa::Avx512: return "avx512";
   }
   return "?";
 }
@@ -61,16 +61,16 @@ constexpr std::string_view isa_name(Isa isa) {
 // Lanes of a float batch in the copy for isa (generic: unknown, 0).
 constexpr int float_lanes(Isa isa) {
   switch (isa) {
-    case Isa::sse2: return 4;
-    case Isa::avx2: return 8;
-    case Isa::avx512: return 16;
-    case Isa::generic: return 0;
+    case Isa::Sse2: return 4;
+    case Isa::Avx2: return 8;
+    case Isa::Avx512: return 16;
+    case Isa::Generic: return 0;
   }
   return 0;
 }
 
 inline std::optional<Isa> parse_isa(std::string_view name) {
-  for (Isa isa : {Isa::generic, Isa::sse2, Isa::avx2, Isa::avx512})
+  for (Isa isa : {Isa::Generic, Isa::Sse2, Isa::Avx2, Isa::Avx512})
     if (isa_name(isa) == name) return isa;
   return std::nullopt;
 }
@@ -85,17 +85,17 @@ inline bool is_compiled(Isa isa) {
 inline bool cpu_supports(Isa isa) {
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
   switch (isa) {
-    case Isa::sse2: return true;  // part of x86-64
-    case Isa::avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-    case Isa::avx512:
+    case Isa::Sse2: return true;  // part of x86-64
+    case Isa::Avx2: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    case Isa::Avx512:
       return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512cd") &&
              __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq") &&
              __builtin_cpu_supports("avx512vl");
-    case Isa::generic: return false;
+    case Isa::Generic: return false;
   }
   return false;
 #else
-  return isa == Isa::generic;
+  return isa == Isa::Generic;
 #endif
 }
 
@@ -158,8 +158,8 @@ class ScopedIsa {
 #define SWIRL_SIMD_DISPATCH_TO(isa, function, ...)                               \
   do {                                                                           \
     switch (isa) {                                                               \
-      case ::swirl::simd::Isa::avx512: return isa_avx512::function(__VA_ARGS__); \
-      case ::swirl::simd::Isa::avx2: return isa_avx2::function(__VA_ARGS__);     \
+      case ::swirl::simd::Isa::Avx512: return isa_avx512::function(__VA_ARGS__); \
+      case ::swirl::simd::Isa::Avx2: return isa_avx2::function(__VA_ARGS__);     \
       default: return isa_sse2::function(__VA_ARGS__);                           \
     }                                                                            \
   } while (false)

@@ -78,7 +78,7 @@ class BarnesHut {
                       std::size_t block_size);
 
   // True when compute() walks the linear octree (scheme global, tree linear).
-  bool uses_linear_tree() const { return settings_.scheme == Scheme::global && settings_.tree == Tree::linear; }
+  bool uses_linear_tree() const { return settings_.scheme == Scheme::Global && settings_.tree == Tree::Linear; }
   // The linear octree of the last evaluation (empty unless uses_linear_tree()).
   const LinearOctree<Real>& linear_tree() const { return linear_; }
 

@@ -15,8 +15,8 @@
 namespace swirl::gravity {
 
 struct BenchSettings {
-  Scheme scheme = Scheme::global;
-  Method method = Method::barnes_hut;
+  Scheme scheme = Scheme::Global;
+  Method method = Method::BarnesHut;
   std::size_t n = 4096;
   double opening = 0.5;          // λ (the paper's default)
   int iterations = 50;           // the paper's default
@@ -55,7 +55,7 @@ inline BenchResult time_iterations(Scheme scheme, std::size_t n, double opening,
 
 // One tree configuration whose force error force_errors() measures.
 struct ForceErrorCase {
-  Scheme scheme = Scheme::global;
+  Scheme scheme = Scheme::Global;
   double opening = 0.5;  // λ
 };
 

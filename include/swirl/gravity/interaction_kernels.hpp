@@ -15,9 +15,9 @@
 // The field is ADDED to the targets' ax, ay, az, phi.
 //
 // Two paths of the same formulas:
-//   KernelPath::scalar  a plain loop, target by target, sources in order: the
+//   KernelPath::Scalar  a plain loop, target by target, sources in order: the
 //                       reference the SIMD path is tested against;
-//   KernelPath::simd    explicit SIMD (xsimd) compiled per instruction set and
+//   KernelPath::Simd    explicit SIMD (xsimd) compiled per instruction set and
 //                       picked at run time (core/simd_dispatch.hpp): targets
 //                       across the lanes of a batch, each source broadcast to
 //                       all lanes (the last < W targets, if the list is
@@ -40,6 +40,8 @@
 #pragma once
 
 #include <cstddef>
+
+#include "swirl/core/kernel_path.hpp"
 
 namespace swirl::gravity {
 
@@ -71,17 +73,15 @@ struct Targets {
   std::size_t n;
 };
 
-enum class KernelPath { simd, scalar };
-
 // Adds the pair-law field of every source particle to every target.
 template <class Real>
 void add_particle_field(const SourceParticles<Real>& s, const Targets<Real>& t, Real eps2,
-                        KernelPath path = KernelPath::simd);
+                        KernelPath path = KernelPath::Simd);
 
 // Adds the monopole field of every cell, plus its quadrupole term if `quadrupole`.
 template <class Real>
 void add_cell_field(const SourceCells<Real>& s, const Targets<Real>& t, Real eps2, bool quadrupole,
-                    KernelPath path = KernelPath::simd);
+                    KernelPath path = KernelPath::Simd);
 
 // Flops per interaction (one source on one target), for FLOP/s figures.
 // Convention: the operations of the textbook formulas below (the monopole,

@@ -82,12 +82,12 @@
 namespace swirl::gravity {
 
 struct LinearTreeSettings {
-  Multipole multipole = Multipole::quadrupole;
-  Criterion criterion = Criterion::barnes;
+  Multipole multipole = Multipole::Quadrupole;
+  Criterion criterion = Criterion::Barnes;
   double opening = 0.5;    // λ (paper) or θ (barnes), in [0, 1]
   double softening = 0.01;  // ε
   std::size_t bucket_size = 16;
-  Walk walk = Walk::group;
+  Walk walk = Walk::Group;
   std::size_t group_size = 256;  // the group walk's particles per group, at most (unless a leaf holds more)
   bool simd_kernels = true;     // group walk: false uses the kernels' scalar path (the reference)
 };

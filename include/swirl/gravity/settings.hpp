@@ -22,28 +22,28 @@
 namespace swirl::gravity {
 
 // How the force is computed: the O(N²) reference or the paper's octree.
-enum class Method { direct, barnes_hut };
+enum class Method { Direct, BarnesHut };
 
 // How the Barnes–Hut work is split (Demiroz et al. 2011, section 4):
 //   subdomain  4.1  Morton runs of ≤ subdomain_size particles, one local tree each;
 //   subtree    4.2  one global tree cut depth-first into units of ≤ subtree_nodes nodes;
 //   global     the modern baseline: one global tree, particle blocks on the threads.
-enum class Scheme { subdomain, subtree, global };
+enum class Scheme { Subdomain, Subtree, Global };
 
 // Which octree the global scheme walks:
 //   paper   the paper's tree, built by inserting particles one by one (Fig. 1);
 //   linear  built from sorted 63-bit Morton keys (linear_octree.hpp).
-enum class Tree { paper, linear };
+enum class Tree { Paper, Linear };
 
 // The expansion a linear-tree node's field is computed from: monopole (mass at
 // the centre of mass) or monopole + traceless quadrupole about the centre of mass.
-enum class Multipole { monopole, quadrupole };
+enum class Multipole { Monopole, Quadrupole };
 
 // When a node is opened, d = |centre of mass − particle|, l = the node's side:
 //   paper   the paper's rule, open if l / d ≥ λ;
 //   barnes  Barnes' modified rule, open if d < l / θ + δ, δ = |centre of mass −
 //           geometric centre| (linear_octree.hpp says which failure each prevents).
-enum class Criterion { paper, barnes };
+enum class Criterion { Paper, Barnes };
 
 // How the linear tree is walked:
 //   group     one walk per group of ≤ group_size particles (a leaf or a small
@@ -51,17 +51,17 @@ enum class Criterion { paper, barnes };
 //             bounding box, then the group's interaction list evaluated for all
 //             its particles by the SIMD kernels (interaction_kernels.hpp);
 //   particle  one walk per particle: the group walk's slow twin and reference.
-enum class Walk { group, particle };
+enum class Walk { Group, Particle };
 
 // The names scenes, messages and options use: the only place they are spelt.
-inline constexpr std::array<EnumName<Method>, 2> kMethodNames{{{"direct", Method::direct}, {"barnes_hut", Method::barnes_hut}}};
+inline constexpr std::array<EnumName<Method>, 2> kMethodNames{{{"direct", Method::Direct}, {"barnes_hut", Method::BarnesHut}}};
 inline constexpr std::array<EnumName<Scheme>, 3> kSchemeNames{
-    {{"subdomain", Scheme::subdomain}, {"subtree", Scheme::subtree}, {"global", Scheme::global}}};
-inline constexpr std::array<EnumName<Tree>, 2> kTreeNames{{{"paper", Tree::paper}, {"linear", Tree::linear}}};
+    {{"subdomain", Scheme::Subdomain}, {"subtree", Scheme::Subtree}, {"global", Scheme::Global}}};
+inline constexpr std::array<EnumName<Tree>, 2> kTreeNames{{{"paper", Tree::Paper}, {"linear", Tree::Linear}}};
 inline constexpr std::array<EnumName<Multipole>, 2> kMultipoleNames{
-    {{"monopole", Multipole::monopole}, {"quadrupole", Multipole::quadrupole}}};
-inline constexpr std::array<EnumName<Criterion>, 2> kCriterionNames{{{"paper", Criterion::paper}, {"barnes", Criterion::barnes}}};
-inline constexpr std::array<EnumName<Walk>, 2> kWalkNames{{{"group", Walk::group}, {"particle", Walk::particle}}};
+    {{"monopole", Multipole::Monopole}, {"quadrupole", Multipole::Quadrupole}}};
+inline constexpr std::array<EnumName<Criterion>, 2> kCriterionNames{{{"paper", Criterion::Paper}, {"barnes", Criterion::Barnes}}};
+inline constexpr std::array<EnumName<Walk>, 2> kWalkNames{{{"group", Walk::Group}, {"particle", Walk::Particle}}};
 
 std::string_view to_string(Method method);
 std::string_view to_string(Scheme scheme);
@@ -81,18 +81,21 @@ Criterion parse_criterion(std::string_view name);
 Walk parse_walk(std::string_view name);
 
 struct GravitySettings {
-  Method method = Method::barnes_hut;
-  Scheme scheme = Scheme::global;
-  Tree tree = Tree::linear;  // the global scheme's tree
-  Multipole multipole = Multipole::quadrupole;  // linear tree
-  Criterion criterion = Criterion::barnes;      // linear tree
+  Method method = Method::BarnesHut;
+  Scheme scheme = Scheme::Global;
+  Tree tree = Tree::Linear;  // the global scheme's tree
+  Multipole multipole = Multipole::Quadrupole;  // linear tree
+  Criterion criterion = Criterion::Barnes;      // linear tree
   // Linear tree: a node with more particles than this is split (measured in
   // docs/performance/gravity-tree.md).
   std::size_t bucket_size = 16;
   // Linear tree: per-group or per-particle walk, and the group walk's group
   // size (particles at most, unless one leaf holds more; docs/performance/gravity-tree.md).
-  Walk walk = Walk::group;
+  Walk walk = Walk::Group;
   std::size_t group_size = 256;
+  // The linear tree's interaction kernels: explicit SIMD, or their scalar twin
+  // (the reference; core/kernel_path.hpp).
+  bool simd = true;
   // Linear tree under GravityForce: physically reorder the ParticleSet along
   // the Morton curve at every evaluation (ids survive), so the walk and the
   // integrator stream through memory.

@@ -101,7 +101,7 @@ class FirstError {
 }  // namespace detail
 
 namespace detail {
-enum class Schedule { dynamic, pinned };
+enum class Schedule { Dynamic, Pinned };
 
 template <class Body>
 void run_blocks(Schedule schedule, std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
@@ -116,7 +116,7 @@ void run_blocks(Schedule schedule, std::string_view kernel, std::size_t n, std::
       error.capture();
     }
   };
-  if (schedule == Schedule::pinned) {
+  if (schedule == Schedule::Pinned) {
     const int wanted = static_cast<int>(std::min<std::int64_t>(omp_get_max_threads(), blocks));
     if (wanted <= 1) {
       for (std::int64_t b = 0; b < blocks; ++b) run(b);
@@ -175,13 +175,13 @@ T reduce(Schedule schedule, std::string_view kernel, std::size_t n, std::size_t 
 // by its own block.
 template <class Body>
 void for_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
-  detail::run_blocks(detail::Schedule::dynamic, kernel, n, block_size, std::forward<Body>(body));
+  detail::run_blocks(detail::Schedule::Dynamic, kernel, n, block_size, std::forward<Body>(body));
 }
 
 // for_blocks with every block pinned to the same thread on every call.
 template <class Body>
 void for_blocks_pinned(std::string_view kernel, std::size_t n, std::size_t block_size, Body&& body) {
-  detail::run_blocks(detail::Schedule::pinned, kernel, n, block_size, std::forward<Body>(body));
+  detail::run_blocks(detail::Schedule::Pinned, kernel, n, block_size, std::forward<Body>(body));
 }
 
 // Computes partial = block_result(begin, end) for every block in parallel, then
@@ -190,7 +190,7 @@ void for_blocks_pinned(std::string_view kernel, std::size_t n, std::size_t block
 template <class T, class BlockResult, class Combine>
 T reduce_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, T init, BlockResult&& block_result,
                 Combine&& combine) {
-  return detail::reduce(detail::Schedule::dynamic, kernel, n, block_size, std::move(init),
+  return detail::reduce(detail::Schedule::Dynamic, kernel, n, block_size, std::move(init),
                         std::forward<BlockResult>(block_result), std::forward<Combine>(combine));
 }
 
@@ -198,7 +198,7 @@ T reduce_blocks(std::string_view kernel, std::size_t n, std::size_t block_size, 
 template <class T, class BlockResult, class Combine>
 T reduce_blocks_pinned(std::string_view kernel, std::size_t n, std::size_t block_size, T init,
                        BlockResult&& block_result, Combine&& combine) {
-  return detail::reduce(detail::Schedule::pinned, kernel, n, block_size, std::move(init),
+  return detail::reduce(detail::Schedule::Pinned, kernel, n, block_size, std::move(init),
                         std::forward<BlockResult>(block_result), std::forward<Combine>(combine));
 }
 

@@ -151,7 +151,7 @@ struct Scene {
   // each of mass ρ0·L³/N; the box and a RandomSource are derived from it.
   struct RandomBox {
     std::uint64_t particles = 0;   // N (root key `particles`)
-    double neighbors = 25;         // k (random_box.neighbours)
+    double neighbours = 25;         // k (random_box.neighbours)
     std::uint64_t seed = 1;        // random_box.seed
   };
   std::optional<RandomBox> random_box;

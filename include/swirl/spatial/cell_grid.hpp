@@ -40,6 +40,7 @@
 #include <vector>
 
 #include "swirl/core/aligned.hpp"
+#include "swirl/core/index_range.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/cell_order.hpp"
@@ -47,11 +48,6 @@
 #include "swirl/spatial/particle_order.hpp"
 
 namespace swirl::spatial {
-
-// A half-open range [begin, end) of particle indices (sorted order).
-struct IndexRange {
-  std::uint32_t begin = 0, end = 0;
-};
 
 // The most contiguous ranges the 27 cells around a cell can take (9 with
 // row-major keys: the three cells of a row are adjacent; 27 with Morton keys),

@@ -33,7 +33,7 @@ struct HashStatistics {
   double duplicate_fraction() const {  // of all interactions found with the check off
     return interactions_unchecked ? double(duplicate_interactions) / double(interactions_unchecked) : 0.0;
   }
-  double mean_neighbors() const { return particles ? double(interactions) / double(particles) : 0.0; }
+  double mean_neighbours() const { return particles ? double(interactions) / double(particles) : 0.0; }
 };
 
 // Builds a table of `buckets` buckets with cell length h for the particles and
@@ -61,11 +61,11 @@ HashStatistics hash_statistics(const ParticleSet<Real>& p, Real h, std::uint32_t
       }
     }
   }
-  NeighborList<Real> lists;
+  NeighbourList<Real> lists;
   auto ignore = [](std::uint32_t, const std::uint32_t*, const Real*, std::size_t) {};
   SearchCounters checked, unchecked;
-  hash.find_neighbors(p, true, block_size, lists, ignore, &checked);
-  hash.find_neighbors(p, false, block_size, lists, ignore, &unchecked);
+  hash.find_neighbours(p, true, block_size, lists, ignore, &checked);
+  hash.find_neighbours(p, false, block_size, lists, ignore, &unchecked);
   s.tests = checked.tests;
   s.redundant_tests = checked.redundant_tests;
   s.interactions = checked.interactions;

@@ -23,16 +23,13 @@
 #include <span>
 #include <vector>
 
+#include "swirl/core/index_range.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::spatial {
 
 class OccupiedCellTable {
  public:
-  struct Range {
-    std::uint32_t begin = 0, end = 0;
-  };
-
   // keys: sorted ascending, each below 2^63.
   void build(std::span<const std::uint64_t> keys, std::size_t block_size) {
     const std::size_t n = keys.size();
@@ -58,7 +55,7 @@ class OccupiedCellTable {
     });
   }
 
-  Range range(std::uint64_t key) const {
+  IndexRange range(std::uint64_t key) const {
     for (std::size_t s = home(key);; s = (s + 1) & mask_) {
       const Slot& slot = slots_[s];
       if (slot.key == key) return {slot.begin, slot.end};

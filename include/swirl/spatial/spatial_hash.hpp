@@ -6,14 +6,14 @@
 // thesis ran it serially), and the positions are copied into bucket order as
 // the thesis's table holds them.
 //
-// find_neighbors(): for every particle, in bucket order (the thesis walks the
+// find_neighbours(): for every particle, in bucket order (the thesis walks the
 // table bucket by bucket, Algorithm 4), all 27 cells around its cell are
 // hashed and their buckets scanned. A particle found in a scanned bucket whose
 // cell is not the searched one is there by a hash collision: with the
 // duplicate check on (the default) it is skipped, which also drops the
 // duplicate interactions that arise when two of the 27 cells share a bucket;
 // with it off (the thesis's faster option) such pairs are distance-tested and
-// duplicates can appear. Interaction lists are CSR (NeighborList), one row per
+// duplicates can appear. Interaction lists are CSR (NeighbourList), one row per
 // particle in bucket order, neighbours in scan order: deterministic for any
 // thread count.
 //
@@ -32,7 +32,7 @@
 #include "swirl/parallel/counting_sort.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/distance.hpp"
-#include "swirl/spatial/neighbor_list.hpp"
+#include "swirl/spatial/neighbour_list.hpp"
 #include "swirl/spatial/teschner_hash.hpp"
 
 namespace swirl::spatial {
@@ -84,15 +84,15 @@ class SpatialHash {
   }
 
   // Fills `out` with the interaction lists of every particle (see the header
-  // comment) and calls on_row(i, neighbors, r2, count) right after particle i's
+  // comment) and calls on_row(i, neighbours, r2, count) right after particle i's
   // row is complete (the thesis computes density and pressure there, Algorithm
   // 4). on_row runs in parallel and may only write particle i's data. If
   // `counters` is given, it receives the totals of the search.
   template <class OnRow>
-  void find_neighbors(const ParticleSet<Real>& p, bool duplicate_check, std::size_t block_size,
-                      NeighborList<Real>& out, OnRow&& on_row, SearchCounters* counters = nullptr) {
+  void find_neighbours(const ParticleSet<Real>& p, bool duplicate_check, std::size_t block_size,
+                      NeighbourList<Real>& out, OnRow&& on_row, SearchCounters* counters = nullptr) {
     const std::size_t n = p.size();
-    if (cells_.size() != n) throw std::logic_error("spatial hash: find_neighbors() on particles it was not built for");
+    if (cells_.size() != n) throw std::logic_error("spatial hash: find_neighbours() on particles it was not built for");
     const std::size_t blocks = parallel::block_count(n, block_size);
     if (block_lists_.size() < blocks) block_lists_.resize(blocks);
     std::vector<SearchCounters> block_counters(counters ? blocks : 0);
@@ -101,9 +101,9 @@ class SpatialHash {
     const auto& order = sort_.order();
     const auto& offsets = sort_.offsets();
 
-    parallel::for_blocks("neighbor_search", n, block_size, [&](std::size_t first, std::size_t last, std::size_t blk) {
+    parallel::for_blocks("neighbour_search", n, block_size, [&](std::size_t first, std::size_t last, std::size_t blk) {
       BlockList& list = block_lists_[blk];
-      list.neighbor.clear();
+      list.neighbour.clear();
       list.r2.clear();
       list.row_end.clear();
       SearchCounters local;
@@ -111,7 +111,7 @@ class SpatialHash {
         const std::uint32_t i = order[row];
         const Real xi = sorted_position_[0][row], yi = sorted_position_[1][row], zi = sorted_position_[2][row];
         const Cell ci = sorted_cells_[row];
-        const std::size_t row_begin = list.neighbor.size();
+        const std::size_t row_begin = list.neighbour.size();
         for (int dk = -1; dk <= 1; ++dk)
           for (int dj = -1; dj <= 1; ++dj)
             for (int di = -1; di <= 1; ++di) {
@@ -128,16 +128,16 @@ class SpatialHash {
                 const Real r2 = distance2(xi, yi, zi, sorted_position_[0][s], sorted_position_[1][s],
                                           sorted_position_[2][s]);
                 if (within(r2, h2)) {
-                  list.neighbor.push_back(order[s]);
+                  list.neighbour.push_back(order[s]);
                   list.r2.push_back(r2);
                 }
               }
             }
-        list.row_end.push_back(list.neighbor.size());
-        on_row(i, list.neighbor.data() + row_begin, list.r2.data() + row_begin, list.neighbor.size() - row_begin);
+        list.row_end.push_back(list.neighbour.size());
+        on_row(i, list.neighbour.data() + row_begin, list.r2.data() + row_begin, list.neighbour.size() - row_begin);
       }
       if (counters) {
-        local.interactions = list.neighbor.size();
+        local.interactions = list.neighbour.size();
         block_counters[blk] = local;
       }
     });
@@ -159,9 +159,9 @@ class SpatialHash {
 
  private:
   struct BlockList {
-    std::vector<std::uint32_t> neighbor;
+    std::vector<std::uint32_t> neighbour;
     std::vector<Real> r2;
-    std::vector<std::size_t> row_end;  // end of each row in neighbor, block-local
+    std::vector<std::size_t> row_end;  // end of each row in neighbour, block-local
   };
 
   // Neighbour cell coordinate with the wrap-around the hash uses anyway
@@ -171,17 +171,17 @@ class SpatialHash {
   }
 
   // Concatenates the block lists into one CSR list, in block order.
-  void gather(std::size_t n, std::size_t blocks, std::size_t block_size, NeighborList<Real>& out) {
+  void gather(std::size_t n, std::size_t blocks, std::size_t block_size, NeighbourList<Real>& out) {
     std::vector<std::size_t> block_start(blocks + 1, 0);
-    for (std::size_t b = 0; b < blocks; ++b) block_start[b + 1] = block_start[b] + block_lists_[b].neighbor.size();
+    for (std::size_t b = 0; b < blocks; ++b) block_start[b + 1] = block_start[b] + block_lists_[b].neighbour.size();
     out.row_particle.assign(sort_.order().begin(), sort_.order().end());
     out.offsets.resize(n + 1);
-    out.neighbor.resize(block_start[blocks]);
+    out.neighbour.resize(block_start[blocks]);
     out.r2.resize(block_start[blocks]);
     out.offsets[0] = 0;
     parallel::for_blocks("gather_lists", n, block_size, [&](std::size_t first, std::size_t last, std::size_t b) {
       const BlockList& list = block_lists_[b];
-      std::copy(list.neighbor.begin(), list.neighbor.end(), out.neighbor.begin() + static_cast<std::ptrdiff_t>(block_start[b]));
+      std::copy(list.neighbour.begin(), list.neighbour.end(), out.neighbour.begin() + static_cast<std::ptrdiff_t>(block_start[b]));
       std::copy(list.r2.begin(), list.r2.end(), out.r2.begin() + static_cast<std::ptrdiff_t>(block_start[b]));
       for (std::size_t row = first; row < last; ++row) out.offsets[row + 1] = block_start[b] + list.row_end[row - first];
     });

@@ -19,14 +19,10 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "swirl/core/index_range.hpp"
 #include "swirl/sph/laws.hpp"
 
 namespace swirl::sph {
-
-// A half-open range [begin, end) of candidate indices (sorted order).
-struct CandidateRange {
-  std::uint32_t begin = 0, end = 0;
-};
 
 // Inputs and outputs of the density pass (grid_density()).
 template <class Real>
@@ -52,15 +48,15 @@ struct ForceKernelArgs {
 // Density and pressure (and the scratch) of particles [first, last); returns
 // their neighbour pairs, self excluded.
 std::uint64_t density_cell_simd(const DensityKernelArgs<float>& a, std::size_t first, std::size_t last,
-                                const CandidateRange* ranges, int count);
+                                const IndexRange* ranges, int count);
 std::uint64_t density_cell_simd(const DensityKernelArgs<double>& a, std::size_t first, std::size_t last,
-                                const CandidateRange* ranges, int count);
+                                const IndexRange* ranges, int count);
 
 // Adds the pressure and viscosity accelerations of particles [first, last).
 void forces_cell_simd(const ForceKernelArgs<float>& a, std::size_t first, std::size_t last,
-                      const CandidateRange* ranges, int count);
+                      const IndexRange* ranges, int count);
 void forces_cell_simd(const ForceKernelArgs<double>& a, std::size_t first, std::size_t last,
-                      const CandidateRange* ranges, int count);
+                      const IndexRange* ranges, int count);
 
 // Lanes of a float batch in the copy the passes now run (simd::active()),
 // asked of that copy: equals simd::float_lanes(simd::active()) on x86-64.

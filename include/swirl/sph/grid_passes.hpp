@@ -12,15 +12,16 @@
 // whole: every candidate j is distance-tested and masked with
 // spatial::within(), so the pairs are exactly the hash's (to the rounding of
 // r² where the AVX2/AVX-512 copies fuse it into FMAs: a pair within one ulp of
-// h² may fall either way). Two implementations of each pass, selected by `Simd`:
-//  - Simd = true: explicit SIMD with xsimd, a batch of candidates per
+// h² may fall either way). Two implementations of each pass, selected at run
+// time by a KernelPath (core/kernel_path.hpp; the scene key sph.grid.simd):
+//  - KernelPath::Simd: explicit SIMD with xsimd, a batch of candidates per
 //    iteration, lanes past the range masked. The cell bodies are compiled once
 //    per instruction set (src/sph/grid_passes_simd.cpp, sph/grid_pass_kernels.hpp)
 //    and the width is chosen at run time, not by the build's flags: the widest
 //    the CPU runs (16 floats with AVX-512, 8 with AVX2 + FMA, 4 with SSE2), or
 //    the one SWIRL_SIMD names (core/simd_dispatch.hpp);
-//  - Simd = false: the scalar twin (the same evaluators one pair at a time), the
-//    reference the SIMD path is tested against and the "without vectorisation"
+//  - KernelPath::Scalar: the scalar twin (the same evaluators one pair at a
+//    time), the reference the SIMD path is tested against and the "without vectorisation"
 //    of the benchmark.
 // Each particle's sums are gathered into its own entries in a fixed order that
 // depends only on positions and memory order: bit-identical for any thread
@@ -36,6 +37,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "swirl/core/kernel_path.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/simd_dispatch.hpp"
 #include "swirl/parallel/for_blocks.hpp"
@@ -79,22 +81,13 @@ void for_each_in_cells(const spatial::SortedCellGrid<Real>& grid, std::size_t b,
   });
 }
 
-// The grid's ranges as the SIMD kernels take them.
-struct KernelRanges {
-  std::array<CandidateRange, spatial::kMaxNeighbourRanges> ranges{};
-  KernelRanges(const spatial::NeighbourRanges& from, int count) {
-    for (std::size_t r = 0; r < static_cast<std::size_t>(count); ++r) ranges[r] = {from[r].begin, from[r].end};
-  }
-  const CandidateRange* data() const { return ranges.data(); }
-};
-
 }  // namespace detail
 
 // Density and pressure of every particle; returns the neighbour pairs found
 // (self excluded), for the mean neighbour count.
-template <class Real, bool Simd>
+template <class Real>
 std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
-                           std::size_t block_size, GridScratch<Real>& scratch) {
+                           std::size_t block_size, GridScratch<Real>& scratch, KernelPath path) {
   const std::size_t n = p.size();
   scratch.volume.resize(n);
   scratch.pressure_volume.resize(n);
@@ -102,7 +95,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real *rho = p.density.data(), *pr = p.pressure.data();
   const auto sum_blocks = [](std::uint64_t a, std::uint64_t b) { return a + b; };
-  if constexpr (Simd) {
+  if (path == KernelPath::Simd) {
     simd::active();  // a bad SWIRL_SIMD throws here, not inside the parallel region
     DensityKernelArgs<Real> a;
     a.x = x, a.y = y, a.z = z, a.mass = m, a.density = rho, a.pressure = pr;
@@ -113,7 +106,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
         [&](std::size_t b, std::size_t e) {
           std::uint64_t pairs = 0;
           detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
-            pairs += density_cell_simd(a, first, last, detail::KernelRanges(ranges, count).data(), count);
+            pairs += density_cell_simd(a, first, last, ranges.data(), count);
           });
           return pairs;
         },
@@ -156,16 +149,16 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
 // scratch from grid_density()): per pair PressureLaw::term · r⃗ and
 // ViscosityLaw::term · (v_j − v_i) summed, SphLaws::acceleration() once per
 // particle.
-template <class Real, bool Simd>
+template <class Real>
 void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
-                 std::size_t block_size, const GridScratch<Real>& scratch) {
+                 std::size_t block_size, const GridScratch<Real>& scratch, KernelPath path) {
   const std::size_t n = p.size();
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
   const Real *V = scratch.volume.data(), *PV = scratch.pressure_volume.data(), *pr = p.pressure.data();
   const Real* rho = p.density.data();
   Real *ax = p.acceleration.x.data(), *ay = p.acceleration.y.data(), *az = p.acceleration.z.data();
-  if constexpr (Simd) {
+  if (path == KernelPath::Simd) {
     simd::active();  // a bad SWIRL_SIMD throws here, not inside the parallel region
     ForceKernelArgs<Real> a;
     a.x = x, a.y = y, a.z = z, a.vx = vx, a.vy = vy, a.vz = vz;
@@ -174,7 +167,7 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     a.laws = laws;
     parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
-        forces_cell_simd(a, first, last, detail::KernelRanges(ranges, count).data(), count);
+        forces_cell_simd(a, first, last, ranges.data(), count);
       });
     });
     return;

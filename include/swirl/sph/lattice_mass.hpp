@@ -29,10 +29,10 @@ inline double lattice_mass_for_density(double spacing, double h, double rest_den
 // The h whose ball holds k neighbours on average when each particle occupies
 // volume v: (4/3)π h³ = (k + 1)·v counts the particle itself, so
 // h = (3 (k + 1) v / (4π))^(1/3). Self is not a neighbour (section 4.2).
-inline double smoothing_length_for_neighbors(double neighbors, double volume_per_particle) {
-  if (!(neighbors > 0) || !(volume_per_particle > 0))
+inline double smoothing_length_for_neighbours(double neighbours, double volume_per_particle) {
+  if (!(neighbours > 0) || !(volume_per_particle > 0))
     throw std::invalid_argument("smoothing length: need neighbours > 0 and a positive particle volume");
-  return std::cbrt(3.0 * (neighbors + 1.0) * volume_per_particle / (4.0 * std::numbers::pi));
+  return std::cbrt(3.0 * (neighbours + 1.0) * volume_per_particle / (4.0 * std::numbers::pi));
 }
 
 }  // namespace swirl::sph

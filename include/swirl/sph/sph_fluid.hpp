@@ -168,12 +168,12 @@ class SphFluid final : public Solver<Real> {
           return s;
         },
         [](Partial a, const Partial& b) { return Partial{a[0] + b[0], std::max(a[1], b[1])}; });
-    row.insert(row.end(), {p.empty() ? 0.0 : e[0] / double(p.size()), e[1], mean_neighbors_});
+    row.insert(row.end(), {p.empty() ? 0.0 : e[0] / double(p.size()), e[1], mean_neighbours_});
   }
   // Viscosity dissipates, and the equation of state's elastic energy is not counted.
   bool conserves_energy() const override { return false; }
   void add_metrics(NamedValues& out) const override {
-    out.emplace_back("mean_neighbours", evaluations_ > 0 ? neighbour_sum_ / double(evaluations_) : mean_neighbors_);
+    out.emplace_back("mean_neighbours", evaluations_ > 0 ? neighbour_sum_ / double(evaluations_) : mean_neighbours_);
   }
   void save_state(NamedValues& out) const override {
     out.emplace_back("sph.neighbour_sum", neighbour_sum_);
@@ -186,9 +186,9 @@ class SphFluid final : public Solver<Real> {
 
   // Interaction lists of the last evaluation (one row per particle; hash search
   // only: the grid computes on the fly and leaves them empty).
-  const spatial::NeighborList<Real>& lists() const { return lists_; }
+  const spatial::NeighbourList<Real>& lists() const { return lists_; }
   // Mean neighbours per particle in the last evaluation (self excluded).
-  double mean_neighbors() const { return mean_neighbors_; }
+  double mean_neighbours() const { return mean_neighbours_; }
   const spatial::SpatialHash<Real>& hash() const { return hash_; }
   const spatial::SortedCellGrid<Real>& grid() const { return grid_; }
   const SphParameters& parameters() const { return params_; }
@@ -200,14 +200,14 @@ class SphFluid final : public Solver<Real> {
   std::size_t scratch_bytes() const override {
     return grid_.bytes() + scratch_.bytes() +
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
-           lists_.neighbor.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
+           lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
            hash_.offsets().capacity() * sizeof(std::uint32_t) + hash_.order().capacity() * sizeof(std::uint32_t);
   }
 
  private:
   void count_evaluation() {
-    neighbour_sum_ += mean_neighbors_;
+    neighbour_sum_ += mean_neighbours_;
     ++evaluations_;
   }
 
@@ -228,17 +228,13 @@ class SphFluid final : public Solver<Real> {
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.density");
-      pairs = params_.simd ? grid_density<Real, true>(grid_, p, k, ctx.block_size, scratch_)
-                           : grid_density<Real, false>(grid_, p, k, ctx.block_size, scratch_);
+      pairs = grid_density(grid_, p, k, ctx.block_size, scratch_, kernel_path());
     }
-    mean_neighbors_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
+    mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
     count_evaluation();
     {
       PhaseScope phase(ctx, "forces.sph");
-      if (params_.simd)
-        grid_forces<Real, true>(grid_, p, k, ctx.block_size, scratch_);
-      else
-        grid_forces<Real, false>(grid_, p, k, ctx.block_size, scratch_);
+      grid_forces(grid_, p, k, ctx.block_size, scratch_, kernel_path());
     }
     return true;
   }
@@ -258,7 +254,7 @@ class SphFluid final : public Solver<Real> {
       const Real* m = p.mass.data();
       Real* rho = p.density.data();
       Real* pressure = p.pressure.data();
-      hash_.find_neighbors(p, params_.duplicate_check, ctx.block_size, lists_,
+      hash_.find_neighbours(p, params_.duplicate_check, ctx.block_size, lists_,
                            [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t count) {
                              // The particle itself (r = 0), then its neighbours (all r < h).
                              Real sum = laws.density.term(m[i], laws.gap2(Real(0)));
@@ -272,7 +268,7 @@ class SphFluid final : public Solver<Real> {
       PhaseScope phase(ctx, "forces.sph");
       add_pair_forces(p, ctx.block_size);
     }
-    mean_neighbors_ = lists_.rows() ? static_cast<double>(lists_.interactions()) / static_cast<double>(lists_.rows()) : 0.0;
+    mean_neighbours_ = lists_.rows() ? static_cast<double>(lists_.interactions()) / static_cast<double>(lists_.rows()) : 0.0;
   }
 
   // Times a sub-phase when the caller keeps timers.
@@ -297,7 +293,7 @@ class SphFluid final : public Solver<Real> {
         const std::uint32_t i = L.row_particle[row];
         Real px = 0, py = 0, pz = 0, qx = 0, qy = 0, qz = 0;  // pressure and viscosity sums
         for (std::size_t k = L.offsets[row]; k < L.offsets[row + 1]; ++k) {
-          const std::uint32_t j = L.neighbor[k];
+          const std::uint32_t j = L.neighbour[k];
           // 1/r = 0 at r = 0 (coincident particles): no pressure force without a direction.
           const Real r = std::sqrt(L.r2[k]), inv_r = r > Real(0) ? Real(1) / r : Real(0), q = laws.gap(r);
           const Real vol_j = m[j] / rho[j];
@@ -321,11 +317,13 @@ class SphFluid final : public Solver<Real> {
   SphParameters params_;
   StepConditions conditions_;
   spatial::SpatialHash<Real> hash_;
-  spatial::NeighborList<Real> lists_;
+  spatial::NeighbourList<Real> lists_;
   spatial::SortedCellGrid<Real> grid_;
   GridScratch<Real> scratch_;
-  double mean_neighbors_ = 0;
-  double neighbour_sum_ = 0;     // Σ of mean_neighbors_ over evaluations (the summary's mean)
+  KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
+
+  double mean_neighbours_ = 0;
+  double neighbour_sum_ = 0;     // Σ of mean_neighbours_ over evaluations (the summary's mean)
   std::uint64_t evaluations_ = 0;
   bool used_grid_ = false;
 };
