@@ -1,10 +1,12 @@
 #include "swirl/io/checkpoint.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -70,17 +72,27 @@ class Cursor {
   std::size_t pos_ = 0;
 };
 
+// "2 and 3", "2, 3 and 4": the versions this build reads, for messages.
+std::string readable_versions() {
+  std::string out = std::to_string(kOldestReadableCheckpointVersion);
+  for (std::uint32_t v = kOldestReadableCheckpointVersion + 1; v <= kCheckpointVersion; ++v)
+    out += (v == kCheckpointVersion ? " and " : ", ") + std::to_string(v);
+  return out;
+}
+
 CheckpointHeader parse_header(Cursor& in) {
   if (in.take(kMagic.size(), "the magic") != kMagic) throw detail::Malformed("not a swirl checkpoint (bad magic)");
   const auto version = in.get<std::uint32_t>("the version");
-  if (version != kCheckpointVersion)
+  if (version < kOldestReadableCheckpointVersion || version > kCheckpointVersion)
     throw detail::Malformed(fmt::format(
-        "format version {} is not supported: this swirl reads version {} only{}", version, kCheckpointVersion,
+        "format version {} is not supported: this swirl reads version{} {}{}", version,
+        kOldestReadableCheckpointVersion == kCheckpointVersion ? "" : "s", readable_versions(),
         version == 1 ? " (version 1 was written before the run state moved under owner prefixes such as "
                        "\"frames.written\" and \"clock.previous_dt\"; resume it with the swirl that wrote it)"
         : version < kCheckpointVersion ? " (written by an older swirl)"
                                        : " (written by a newer swirl)"));
   CheckpointHeader h;
+  h.version = version;
   h.real_bytes = in.get<std::uint32_t>("the precision");
   if (h.real_bytes != 4 && h.real_bytes != 8)
     throw detail::Malformed(fmt::format("bad precision: {} bytes per real", h.real_bytes));
@@ -120,6 +132,28 @@ CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, Che
     reals_per_particle += components;
     fields.emplace_back(std::move(name), components);
   }
+  // Version 2 has no integer section: its files hold no integer fields.
+  std::vector<std::string> int_fields;
+  if (h.version >= 3) {
+    const auto int_field_count = in.get<std::uint32_t>("the integer field count");
+    if (int_field_count > kMaxFields)
+      throw detail::Malformed(fmt::format("bad integer field count {}", int_field_count));
+    for (std::uint32_t f = 0; f < int_field_count; ++f) {
+      auto name = in.name("an integer field name");
+      for (const auto& [seen, c] : fields)
+        if (seen == name) throw detail::Malformed(fmt::format("field '{}' is listed twice", name));
+      for (const auto& seen : int_fields)
+        if (seen == name) throw detail::Malformed(fmt::format("field '{}' is listed twice", name));
+      if (name == "id") throw detail::Malformed("a field may not be called 'id'");
+      int_fields.push_back(std::move(name));
+    }
+  }
+  // A run's integer field that the file lacks would keep values that are not
+  // the checkpoint's (not even in its particle order): refused, not guessed.
+  for (const auto& run_field : std::as_const(particles).int_fields())
+    if (std::find(int_fields.begin(), int_fields.end(), run_field.name) == int_fields.end())
+      throw detail::Malformed(fmt::format("has no integer field '{}', which the run declares{}", run_field.name,
+                                          h.version < 3 ? " (version 2 files hold no integer fields)" : ""));
   const auto value_count = in.get<std::uint32_t>("the value count");
   if (value_count > kMaxValues) throw detail::Malformed(fmt::format("bad value count {}", value_count));
   CheckpointValues read_values;
@@ -128,7 +162,9 @@ CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, Che
     read_values.emplace_back(std::move(name), in.get<double>("a value"));
   }
   // The data must fill the rest exactly: checked before anything is allocated.
-  const std::uint64_t expected = h.particles * (reals_per_particle * sizeof(Real) + sizeof(std::uint64_t));
+  using Int = typename ParticleSet<Real>::int_type;
+  const std::uint64_t expected =
+      h.particles * (reals_per_particle * sizeof(Real) + int_fields.size() * sizeof(Int) + sizeof(std::uint64_t));
   if (in.remaining() != expected)
     throw detail::Malformed(fmt::format("holds {} bytes of particle data, {} particles need {}", in.remaining(),
                                         h.particles, expected));
@@ -145,6 +181,13 @@ CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, Che
       throw detail::Malformed(fmt::format("field '{}': {}", name, e.what()));
     }
   }
+  for (const auto& name : int_fields) {
+    try {
+      particles.add_int_field(name);
+    } catch (const std::invalid_argument& e) {  // a built-in or real field of that name
+      throw detail::Malformed(fmt::format("field '{}': {}", name, e.what()));
+    }
+  }
   auto views = particles.fields();
   for (const auto& [name, components] : fields) {
     FieldView<Real>* view = nullptr;
@@ -156,6 +199,10 @@ CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, Che
       const auto raw = in.take(n * sizeof(Real), name);
       if (n) std::memcpy(view->data[c], raw.data(), raw.size());
     }
+  }
+  for (const auto& name : int_fields) {
+    const auto raw = in.take(n * sizeof(Int), name);
+    if (n) std::memcpy(particles.int_field(particles.find_int_field(name)).data(), raw.data(), raw.size());
   }
   const auto ids = in.take(n * sizeof(std::uint64_t), "the ids");
   if (n) std::memcpy(particles.id.data(), ids.data(), ids.size());
@@ -169,8 +216,10 @@ template <class Real>
 void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>& particles,
                       const CheckpointHeader& header, const CheckpointValues& values) {
   std::string out;
+  using Int = typename ParticleSet<Real>::int_type;
   const auto fields = particles.fields();
-  std::size_t data = particles.size() * sizeof(std::uint64_t);
+  const auto int_fields = particles.int_fields();
+  std::size_t data = particles.size() * (sizeof(std::uint64_t) + int_fields.size() * sizeof(Int));
   for (const auto& f : fields) data += static_cast<std::size_t>(f.components) * particles.size() * sizeof(Real);
   out.reserve(data + 4096);
   out.append(kMagic);
@@ -185,6 +234,8 @@ void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>
     put_name(out, f.name);
     put<std::uint32_t>(out, static_cast<std::uint32_t>(f.components));
   }
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(int_fields.size()));
+  for (const auto& f : int_fields) put_name(out, f.name);
   put<std::uint32_t>(out, static_cast<std::uint32_t>(values.size()));
   for (const auto& [name, value] : values) {
     put_name(out, name);
@@ -193,6 +244,7 @@ void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>
   for (const auto& f : fields)
     for (int c = 0; c < f.components; ++c)
       out.append(reinterpret_cast<const char*>(f.data[c]), particles.size() * sizeof(Real));
+  for (const auto& f : int_fields) out.append(reinterpret_cast<const char*>(f.data[0]), particles.size() * sizeof(Int));
   out.append(reinterpret_cast<const char*>(particles.id.data()), particles.size() * sizeof(std::uint64_t));
   put<std::uint64_t>(out, fnv1a(out));
   write_file_atomic(path, out, /*sync=*/true);

@@ -37,6 +37,9 @@ void write_csv(const std::filesystem::path& path, const ParticleSet<Real>& parti
       for (const char* axis : {"_x", "_y", "_z"}) out += ',' + csv_cell(std::string(f.name) + axis);
     }
   }
+  const auto int_fields = particles.int_fields();
+  for (const auto& f : int_fields)
+    if (!f.internal) out += ',' + csv_cell(f.name);
   out += '\n';
 
   auto sink = std::back_inserter(out);
@@ -47,6 +50,8 @@ void write_csv(const std::filesystem::path& path, const ParticleSet<Real>& parti
       if (f.name == "position" || f.internal) continue;
       for (int c = 0; c < f.components; ++c) fmt::format_to(sink, ",{}", f.data[c][i]);
     }
+    for (const auto& f : int_fields)
+      if (!f.internal) fmt::format_to(sink, ",{}", f.data[0][i]);
     out += '\n';
   }
   write_file_atomic(path, out);

@@ -30,6 +30,7 @@ constexpr const char* vtk_type() {
   if constexpr (std::is_same_v<T, float>) return "Float32";
   else if constexpr (std::is_same_v<T, double>) return "Float64";
   else if constexpr (std::is_same_v<T, std::uint64_t>) return "UInt64";
+  else if constexpr (std::is_same_v<T, std::int32_t>) return "Int32";
   else {
     static_assert(std::is_same_v<T, std::int64_t>);
     return "Int64";
@@ -80,10 +81,11 @@ void put(char*& out, T value) {
   out += sizeof value;
 }
 
-template <class Real>
-void put_field(VtpBuilder& b, std::string_view indent, const FieldView<const Real>& f, std::size_t n,
+// T: Real for a real field, std::int32_t for an integer one (an Int32 array).
+template <class T>
+void put_field(VtpBuilder& b, std::string_view indent, const FieldView<const T>& f, std::size_t n,
                std::string_view name) {
-  char* out = b.array<Real>(indent, name, f.components, n * static_cast<std::size_t>(f.components));
+  char* out = b.array<T>(indent, name, f.components, n * static_cast<std::size_t>(f.components));
   for (std::size_t i = 0; i < n; ++i)
     for (int c = 0; c < f.components; ++c) put(out, f.data[c][i]);
 }
@@ -336,6 +338,8 @@ void write_vtp(const fs::path& path, const ParticleSet<Real>& particles, double 
   b.line("      <PointData>");
   for (const auto& f : fields)
     if (f.name != "position" && !f.internal) put_field(b, "        ", f, n, f.name);
+  for (const auto& f : particles.int_fields())
+    if (!f.internal) put_field(b, "        ", f, n, f.name);
   out = b.array<std::uint64_t>("        ", "id", 1, n);
   for (std::size_t i = 0; i < n; ++i) put(out, particles.id[i]);
   b.line("      </PointData>");

@@ -419,6 +419,7 @@ std::size_t bytes_per_particle(const Simulation<Real>& sim) {
   const auto& p = sim.particles();
   std::size_t bytes = sizeof(std::uint64_t);  // id
   for (const auto& f : p.fields()) bytes += static_cast<std::size_t>(f.components) * sizeof(Real);
+  bytes += p.int_field_count() * sizeof(typename ParticleSet<Real>::int_type);
   if (p.empty()) return bytes;
   std::size_t scratch = sim.order().bytes();
   for (const auto& s : sim.solvers()) scratch += s->scratch_bytes();

@@ -54,6 +54,10 @@ std::optional<std::string> replay_checkpoint_as(std::string_view bytes) {
     require(particles.id.size() == particles.size(), "ids not one per particle");
     for (const auto& f : particles.fields())
       for (int c = 0; c < f.components; ++c) require(f.data[c] != nullptr || particles.empty(), "field without data");
+    for (const auto& f : particles.int_fields())
+      require(f.data[0] != nullptr || particles.empty(), "integer field without data");
+    require(h.version >= io::kOldestReadableCheckpointVersion && h.version <= io::kCheckpointVersion,
+            "accepted a format version this swirl does not read");
   } catch (const io::IoError& e) {
     check_error_message(e.what(), kCheckpointName);
     return std::string(e.what());

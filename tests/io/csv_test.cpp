@@ -63,9 +63,10 @@ TYPED_TEST(CsvTest, HeaderAndRowsParseBackExactly) {
   EXPECT_EQ(lines[1],
             "id,x,y,z,velocity_x,velocity_y,velocity_z,acceleration_x,acceleration_y,acceleration_z,"
             "acceleration_prev_x,acceleration_prev_y,acceleration_prev_z,mass,density,pressure,temperature,"
-            "vorticity_x,vorticity_y,vorticity_z");
+            "vorticity_x,vorticity_y,vorticity_z,kind");
 
   const auto fields = particles.fields();
+  const std::size_t kind = particles.find_int_field("kind");
   for (std::size_t i = 0; i < n; ++i) {
     const auto cells = split(lines[i + 2]);
     ASSERT_EQ(cells.size(), split(lines[1]).size()) << "row " << i;
@@ -73,8 +74,9 @@ TYPED_TEST(CsvTest, HeaderAndRowsParseBackExactly) {
     std::vector<Real> expected, got;
     for (const auto& f : fields)  // position first, as in the columns
       for (int c = 0; c < f.components; ++c) expected.push_back(f.data[c][i]);
-    for (std::size_t k = 1; k < cells.size(); ++k) got.push_back(parse<Real>(cells[k]));
+    for (std::size_t k = 1; k + 1 < cells.size(); ++k) got.push_back(parse<Real>(cells[k]));
     EXPECT_EQ(bytes_of(got), bytes_of(expected)) << "row " << i << ": " << lines[i + 2];
+    EXPECT_EQ(parse<std::int32_t>(cells.back()), particles.int_field(kind)[i]) << "row " << i;
   }
 }
 
@@ -94,7 +96,20 @@ TYPED_TEST(CsvTest, QuotesFieldNamesWithCommas) {
   write_csv(path, particles, 0.0);
   const auto lines = lines_of(slurp(path));
   ASSERT_EQ(lines.size(), 3u);
-  EXPECT_TRUE(lines[1].ends_with(",vorticity_z,\"a,\"\"b\"\"\"")) << lines[1];
+  EXPECT_TRUE(lines[1].ends_with(",vorticity_z,\"a,\"\"b\"\"\",kind")) << lines[1];
+}
+
+// Internal fields, real or integer, are state, not output: no column.
+TYPED_TEST(CsvTest, LeavesInternalFieldsOut) {
+  auto particles = make_particles<TypeParam>(2);
+  particles.add_field("scratch", 1, FieldUse::Internal);
+  particles.int_field(particles.add_int_field("flag", FieldUse::Internal))[1] = 5;
+  const auto path = this->dir / "frame.csv";
+  write_csv(path, particles, 0.0);
+  const auto lines = lines_of(slurp(path));
+  ASSERT_EQ(lines.size(), 4u);
+  EXPECT_TRUE(lines[1].ends_with(",vorticity_z,kind")) << lines[1];
+  EXPECT_EQ(split(lines[3]).size(), split(lines[1]).size());
 }
 
 TYPED_TEST(CsvTest, WriteFailureThrows) {

@@ -4,9 +4,11 @@
 // file is read or refused with an IoError naming it; nothing else may escape.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <exception>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "fuzz/checkpoint_replay.hpp"
 #include "fuzz/io_replay.hpp"
@@ -77,8 +79,9 @@ TEST(CheckpointFuzzRegressions, SeedCorpusIsReadOrRefusedWithIoError) {
   replay_all_checkpoints(kFuzzDir / "corpus" / "checkpoint");
 }
 
-// The seeds swirl wrote are read in their own precision only; the truncated
-// one and the one claiming a future format version are refused.
+// The seeds swirl wrote are read in their own precision only (those named
+// *_v2 by the version-2 writer, still read); the truncated one, the one
+// claiming a future format version and the version-1 one are refused.
 TEST(CheckpointFuzzRegressions, SeedsAreReadOrRefusedAsExpected) {
   for (const auto& file : input_files(kFuzzDir / "corpus" / "checkpoint")) {
     const std::string name = file.filename().string();
@@ -87,10 +90,35 @@ TEST(CheckpointFuzzRegressions, SeedsAreReadOrRefusedAsExpected) {
     const bool is_float = name.find("float") != std::string::npos;
     EXPECT_EQ(replay_checkpoint_as<float>(bytes).has_value(), broken || !is_float) << name;
     EXPECT_EQ(replay_checkpoint_as<double>(bytes).has_value(), broken || is_float) << name;
+    if (broken) continue;
+    ParticleSet<double> d;
+    ParticleSet<float> f;
+    io::CheckpointValues values;
+    const io::CheckpointHeader h = is_float ? io::parse_checkpoint<float>(bytes, name, f, values)
+                                            : io::parse_checkpoint<double>(bytes, name, d, values);
+    EXPECT_EQ(h.version, name.ends_with("_v2.ckp") ? 2u : io::kCheckpointVersion) << name;
   }
-  const auto refusal = replay_checkpoint_as<double>(file_bytes(kFuzzDir / "corpus" / "checkpoint" / "version3.ckp"));
-  ASSERT_TRUE(refusal.has_value());
-  EXPECT_NE(refusal->find("version 3"), std::string::npos) << *refusal;
+  const auto newer = replay_checkpoint_as<double>(file_bytes(kFuzzDir / "corpus" / "checkpoint" / "version4.ckp"));
+  ASSERT_TRUE(newer.has_value());
+  EXPECT_NE(newer->find("version 4 is not supported"), std::string::npos) << *newer;
+  EXPECT_NE(newer->find("written by a newer swirl"), std::string::npos) << *newer;
+  const auto v1 = replay_checkpoint_as<float>(file_bytes(kFuzzDir / "corpus" / "checkpoint" / "version1.ckp"));
+  ASSERT_TRUE(v1.has_value());
+  EXPECT_NE(v1->find("version 1 was written before the run state moved under owner prefixes"), std::string::npos)
+      << *v1;
+}
+
+// The seed with an integer field carries it through the parser.
+TEST(CheckpointFuzzRegressions, TheIntegerFieldSeedHoldsItsField) {
+  ParticleSet<float> p;
+  io::CheckpointValues values;
+  (void)io::parse_checkpoint<float>(file_bytes(kFuzzDir / "corpus" / "checkpoint" / "sph_kind_float_3.ckp"), "seed", p,
+                                    values);
+  ASSERT_EQ(p.size(), 3u);
+  const std::size_t kind = p.find_int_field("kind");
+  ASSERT_NE(kind, ParticleSet<float>::npos);
+  EXPECT_EQ(std::vector<std::int32_t>(p.int_field(kind).begin(), p.int_field(kind).end()),
+            (std::vector<std::int32_t>{1, -7, 2147483647}));
 }
 
 }  // namespace

@@ -65,14 +65,21 @@ inline std::set<std::string> list_dir(const fs::path& dir) {
   return names;
 }
 
-// n particles with two extra fields ("temperature", scalar; "vorticity",
-// vector); every value of every field is distinct and needs all its digits to
-// round-trip, and pressure holds a subnormal and a -0.
+// n particles with two extra real fields ("temperature", scalar; "vorticity",
+// vector) and an integer field ("kind"); every value of every real field is
+// distinct and needs all its digits to round-trip, pressure holds a subnormal
+// and a -0, and "kind" holds negative values and both int32 extremes.
 template <class Real>
 ParticleSet<Real> make_particles(std::size_t n) {
   ParticleSet<Real> p(n);
   p.add_field("temperature", 1);
   p.add_field("vorticity", 3);
+  auto& kind = p.int_field(p.add_int_field("kind"));
+  for (std::size_t i = 0; i < n; ++i) kind[i] = static_cast<std::int32_t>(i % 5) * 1000003 - 2000000;
+  if (n > 2) {
+    kind[0] = std::numeric_limits<std::int32_t>::min();
+    kind[2] = std::numeric_limits<std::int32_t>::max();
+  }
   int k = 0;
   for (auto& f : p.fields()) {
     ++k;

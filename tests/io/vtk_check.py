@@ -4,8 +4,10 @@
 Usage: vtk_check.py OUT_DIR/particles.pvd
 Checks that every frame listed in the .pvd loads without a VTK error or
 warning, has the same number of points, one vertex cell per point, the named
-arrays swirl writes with the right number of components, finite values, and
-a TimeValue equal to the time in the .pvd. Needs Debian's python3-vtk9.
+arrays swirl writes with the right number of components, finite values, every
+other point array (a solver's fields, real or integer) with one tuple per
+point and integer fields as VTK integer arrays, and a TimeValue equal to the
+time in the .pvd. Needs Debian's python3-vtk9.
 """
 import math
 import sys
@@ -58,6 +60,15 @@ def main(pvd: Path) -> int:
                 problems.append(f"array '{array}' has shape {a.GetNumberOfTuples()}x{a.GetNumberOfComponents()}")
             elif array != "id" and not all(math.isfinite(v) for v in vtk_to_numpy(a).ravel()):
                 problems.append(f"array '{array}' has non-finite values")
+        for k in range(pd.GetNumberOfArrays()):
+            a = pd.GetArray(k)
+            if a.GetName() in EXPECTED:
+                continue
+            if a.GetNumberOfTuples() != n:
+                problems.append(f"array '{a.GetName()}' has {a.GetNumberOfTuples()} tuples for {n} points")
+            if a.IsA("vtkDataArray") and a.GetDataType() not in (vtk.VTK_FLOAT, vtk.VTK_DOUBLE, vtk.VTK_INT):
+                problems.append(f"array '{a.GetName()}' has type {a.GetDataTypeAsString()} "
+                                "(swirl writes Float32, Float64 or Int32)")
         ids = vtk_to_numpy(pd.GetArray("id")) if pd.GetArray("id") is not None else []
         if len(ids) and sorted(ids.tolist()) != list(range(n)):
             problems.append("ids are not 0..N-1")

@@ -94,8 +94,19 @@ TYPED_TEST(VtpTest, RoundTripsEveryArrayBitExactly) {
     EXPECT_EQ(a.components, f.components) << name;
     EXPECT_EQ(a.bytes, bytes_of(interleaved(f, n))) << name;
   }
+  for (const auto& f : particles.int_fields()) {
+    const std::string name(f.name);
+    expected_names.insert(name);
+    ASSERT_TRUE(file.point_data.count(name)) << name;
+    const VtpArray& a = file.point_data.at(name);
+    EXPECT_EQ(a.type, "Int32") << name;
+    EXPECT_EQ(a.components, 1) << name;
+    EXPECT_EQ(a.values<std::int32_t>(), std::vector<std::int32_t>(f.data[0], f.data[0] + n)) << name;
+  }
   for (const auto& [name, a] : file.point_data) names.insert(name);
   EXPECT_EQ(names, expected_names);
+  ASSERT_TRUE(file.point_data.count("kind"));
+  EXPECT_EQ(file.point_data.at("kind").values<std::int32_t>().front(), std::numeric_limits<std::int32_t>::min());
   ASSERT_TRUE(file.point_data.count("temperature"));
   ASSERT_TRUE(file.point_data.count("vorticity"));
   EXPECT_EQ(file.point_data.at("temperature").components, 1);
@@ -122,7 +133,8 @@ TYPED_TEST(VtpTest, EmptySetRoundTrips) {
   EXPECT_EQ(file.num_points, 0u);
   EXPECT_EQ(file.points.type, this->kRealType);
   EXPECT_TRUE(file.points.bytes.empty());
-  EXPECT_EQ(file.point_data.size(), particles.fields().size());  // all but position, plus id
+  // every real field but position, every integer field, plus id
+  EXPECT_EQ(file.point_data.size(), particles.fields().size() + particles.int_fields().size());
   for (const auto& [name, a] : file.point_data) EXPECT_TRUE(a.bytes.empty()) << name;
   ASSERT_TRUE(file.field_data.count("TimeValue"));
   EXPECT_EQ(file.field_data.at("TimeValue").values<double>(), std::vector<double>{-2.5});
@@ -159,7 +171,8 @@ TYPED_TEST(VtpTest, WritesTheDocumentedLayout) {
   const std::size_t base = data_start(text);
   ASSERT_NE(base, std::string::npos);
   const auto arrays = data_arrays(text);
-  ASSERT_EQ(arrays.size(), make_particles<Real>(n).fields().size() + 4);  // + TimeValue, id, 2 Verts
+  const auto written = make_particles<Real>(n);
+  ASSERT_EQ(arrays.size(), written.fields().size() + written.int_fields().size() + 4);  // + TimeValue, id, 2 Verts
   std::size_t expected_offset = 0;
   for (const auto& a : arrays) {
     ASSERT_EQ(a.at("format"), "appended");
@@ -168,8 +181,12 @@ TYPED_TEST(VtpTest, WritesTheDocumentedLayout) {
     const std::uint64_t bytes = u64_at(text, base + offset);
     const std::size_t components = a.count("NumberOfComponents") ? std::stoull(a.at("NumberOfComponents")) : 1;
     const std::size_t tuples = a.at("Name") == "TimeValue" ? 1 : n;
-    const std::size_t width = a.at("type") == "Float32" ? 4 : 8;
+    const std::size_t width = a.at("type") == "Float32" || a.at("type") == "Int32" ? 4 : 8;
     EXPECT_EQ(bytes, tuples * components * width) << a.at("Name");
+    if (a.at("Name") == "kind") {
+      EXPECT_EQ(a.at("type"), "Int32");
+      EXPECT_EQ(a.count("NumberOfComponents"), 0u);
+    }
     if (a.at("Name") == "connectivity" || a.at("Name") == "offsets") {
       EXPECT_EQ(a.at("type"), "Int64");
       for (std::size_t i = 0; i < n; ++i)
@@ -193,6 +210,28 @@ TYPED_TEST(VtpTest, EscapesFieldNames) {
   const VtpFile file = read_vtp(path);
   ASSERT_TRUE(file.point_data.count(odd));
   EXPECT_EQ(file.point_data.at(odd).values<Real>(), (std::vector<Real>{0, Real(42.5)}));
+}
+
+// Integer fields: output ones become Int32 arrays placed after the real
+// fields, internal ones are not written (as for real fields).
+TYPED_TEST(VtpTest, WritesOutputIntegerFieldsOnly) {
+  using Real = TypeParam;
+  auto particles = make_particles<Real>(3);
+  particles.int_field(particles.add_int_field("flag", FieldUse::Internal))[0] = 9;
+  particles.int_field(particles.add_int_field("group"))[2] = -4;
+  const auto path = this->dir / "ints.vtp";
+  write_vtp(path, particles, 0.0);
+  const VtpFile file = read_vtp(path);
+  EXPECT_FALSE(file.point_data.count("flag"));
+  ASSERT_TRUE(file.point_data.count("group"));
+  EXPECT_EQ(file.point_data.at("group").type, "Int32");
+  EXPECT_EQ(file.point_data.at("group").values<std::int32_t>(), (std::vector<std::int32_t>{0, 0, -4}));
+  std::vector<std::string> order;
+  for (const auto& a : data_arrays(slurp(path))) order.push_back(a.at("Name"));
+  const auto at = [&](const std::string& name) { return std::find(order.begin(), order.end(), name) - order.begin(); };
+  EXPECT_LT(at("vorticity"), at("kind"));
+  EXPECT_LT(at("kind"), at("group"));
+  EXPECT_LT(at("group"), at("id"));
 }
 
 TYPED_TEST(VtpTest, RejectsEveryTruncation) {
@@ -251,7 +290,7 @@ TYPED_TEST(VtpTest, RejectsCorruptByteCounts) {
   for (const auto& a : data_arrays(text)) {
     const std::size_t at = base + std::stoull(a.at("offset"));
     const std::uint64_t count = u64_at(text, at);
-    const std::size_t width = a.at("type") == "Float32" ? 4 : 8;
+    const std::size_t width = a.at("type") == "Float32" || a.at("type") == "Int32" ? 4 : 8;
     for (std::uint64_t wrong : {~std::uint64_t{0}, count + 1, count + 8 * width * 3, count - width * 3,
                                 std::uint64_t{1} << 62}) {
       std::string corrupt = text;

@@ -249,13 +249,16 @@ TYPED_TEST(CellGridTest, RejectsNonFinitePositions) {
   EXPECT_THROW(order_and_view(order, grid, p, 0.1, 16, spatial::CellOrder::Morton), std::runtime_error);
 }
 
-// The order's reorder moves every field (built-in, extra, internal) with its
-// particle, keeps the ids, and counts an epoch when anything moved.
+// The order's reorder moves every field (built-in, extra, internal, real and
+// integer) with its particle, keeps the ids, and counts an epoch when
+// anything moved.
 TYPED_TEST(CellGridTest, TheOrderMovesEveryFieldAndKeepsIds) {
   using Real = TypeParam;
   auto p = random_particles<Real>(1000, 1.0, 17);
   const std::size_t extra = p.add_field("extra", 3);
   const std::size_t internal = p.add_field("internal", 1, FieldUse::Internal);
+  const std::size_t kind = p.add_int_field("kind");
+  const std::size_t flag = p.add_int_field("flag", FieldUse::Internal);
   for (std::size_t i = 0; i < p.size(); ++i) {
     p.velocity.y[i] = Real(2 * i);
     p.acceleration_prev.z[i] = Real(3 * i);
@@ -263,6 +266,8 @@ TYPED_TEST(CellGridTest, TheOrderMovesEveryFieldAndKeepsIds) {
     p.pressure[i] = Real(5 * i);
     p.extra(extra, 2)[i] = Real(6 * i);
     p.extra(internal)[i] = Real(7 * i);
+    p.int_field(kind)[i] = static_cast<std::int32_t>(i % 7) - 3;
+    p.int_field(flag)[i] = -static_cast<std::int32_t>(i);
     p.id[i] = 1000000 + i;
   }
   for (auto curve : kOrders) {
@@ -286,6 +291,8 @@ TYPED_TEST(CellGridTest, TheOrderMovesEveryFieldAndKeepsIds) {
       EXPECT_EQ(q.pressure[k], p.pressure[i]);
       EXPECT_EQ(q.extra(extra, 2)[k], p.extra(extra, 2)[i]);
       EXPECT_EQ(q.extra(internal)[k], p.extra(internal)[i]);
+      EXPECT_EQ(q.int_field(kind)[k], p.int_field(kind)[i]);
+      EXPECT_EQ(q.int_field(flag)[k], p.int_field(flag)[i]);
       if (k > 0) {
         EXPECT_LE(order.keys()[k - 1], order.keys()[k]);
       }

@@ -5,22 +5,29 @@
 // AlignedVector whose storage starts on a 64-byte boundary.
 //
 // Fields: the built-in ones below, and extra fields that solvers and the
-// particle order declare by name (add_field). An extra field is either written
-// to frames (FieldUse::Output, the default: ParaView shows it) or internal
-// (FieldUse::Internal: state that travels with the particles and with
-// checkpoints but is no physical output, such as the order's reference
-// positions). for_each_array() visits every array, built-in and extra: resize,
-// reorders and checkpoints go through it, so a new field needs no other code.
+// particle order declare by name. An extra field is real (add_field: 1 or 3
+// components of Real) or integer (add_int_field: 1 component of std::int32_t,
+// enough for a particle kind, a flag or a small index; a per-particle count or
+// index beyond 2^31 would need a wider type and a new checkpoint version). An
+// extra field is either written to frames (FieldUse::Output, the default:
+// ParaView shows it) or internal (FieldUse::Internal: state that travels with
+// the particles and with checkpoints but is no physical output, such as the
+// order's reference positions). for_each_array() visits every real array,
+// built-in and extra, and for_each_int_array() every integer one: resize,
+// reorders and checkpoints go through them, so a new field needs no other code.
 //
 // Invariants:
-//  - every field, built-in or extra, has exactly size() elements per component;
-//    change the count only through resize() and the order only through a
-//    reorder (reorder() here, or spatial::ParticleReorder in parallel);
+//  - every field, built-in or extra, real or integer, has exactly size()
+//    elements per component; change the count only through resize() and the
+//    order only through a reorder (reorder() here, or spatial::ParticleReorder
+//    in parallel);
+//  - field names are unique across built-in, real and integer fields (they are
+//    the array names of one frame and of one checkpoint);
 //  - id[i] is the particle's stable identity: it is set once at creation and
 //    travels with the particle through every reorder().
 //
 // Units follow the solver: SI (m, m/s, m/s², kg, kg/m³, Pa) for SPH; G = 1
-// N-body units for gravity.
+// N-body units for gravity. Integer fields carry no unit (a kind, a flag).
 #pragma once
 
 #include <array>
@@ -48,8 +55,9 @@ struct Vec3Array {
   void set(std::size_t i, const Vec3<Real>& v) { x[i] = v.x; y[i] = v.y; z[i] = v.z; }
 };
 
-// A named view of one field: 1 component (scalar) or 3 (vector). The name is
-// the array name written to output files and what ParaView shows.
+// A named view of one field: 1 component (scalar) or 3 (vector; real fields
+// only). The name is the array name written to output files and what ParaView
+// shows. T is Real (or const Real) for real fields, std::int32_t for integer ones.
 template <class T>
 struct FieldView {
   std::string_view name;
@@ -65,6 +73,7 @@ template <class Real>
 class ParticleSet {
  public:
   using value_type = Real;
+  using int_type = std::int32_t;  // the element type of every integer field
 
   ParticleSet() = default;
   explicit ParticleSet(std::size_t n) { resize(n); }
@@ -77,6 +86,7 @@ class ParticleSet {
   // Changes the particle count of every field; new entries are zero.
   void resize(std::size_t n) {
     for_each_array([n](AlignedVector<Real>& a) { a.resize(n); });
+    for_each_int_array([n](AlignedVector<int_type>& a) { a.resize(n); });
     id.resize(n);
   }
 
@@ -90,6 +100,12 @@ class ParticleSet {
     for (auto& e : extra_) for (int c = 0; c < e.components; ++c) f(e.data[static_cast<std::size_t>(c)]);
   }
 
+  // Calls f(AlignedVector<int_type>&) for every integer field, in int_fields() order.
+  template <class F>
+  void for_each_int_array(F&& f) {
+    for (auto& e : int_extra_) f(e.data);
+  }
+
   // Adds an extra field (zero-filled) and returns its index; if a field of that
   // name and shape exists already, returns its index (and keeps its use).
   std::size_t add_field(std::string name, int components, FieldUse use = FieldUse::Output) {
@@ -101,6 +117,7 @@ class ParticleSet {
       }
     }
     if (is_builtin_name(name)) throw std::invalid_argument("field '" + name + "' is a built-in field");
+    if (find_int_field(name) != npos) throw std::invalid_argument("field '" + name + "' exists as an integer field");
     ExtraField f{std::move(name), components, use, {}};
     for (int c = 0; c < components; ++c) f.data[static_cast<std::size_t>(c)].assign(size(), Real(0));
     extra_.push_back(std::move(f));
@@ -117,6 +134,30 @@ class ParticleSet {
   const AlignedVector<Real>& extra(std::size_t k, int c = 0) const { return extra_.at(k).data.at(c); }
   std::size_t extra_count() const { return extra_.size(); }
 
+  // Adds an integer field (one std::int32_t per particle, zero-filled) and
+  // returns its index; if an integer field of that name exists already,
+  // returns its index (and keeps its use). A name taken by a built-in or a
+  // real field is refused.
+  std::size_t add_int_field(std::string name, FieldUse use = FieldUse::Output) {
+    if (const std::size_t k = find_int_field(name); k != npos) return k;
+    if (is_builtin_name(name)) throw std::invalid_argument("field '" + name + "' is a built-in field");
+    if (find_field(name) != npos) throw std::invalid_argument("field '" + name + "' exists as a real field");
+    IntField f{std::move(name), use, {}};
+    f.data.assign(size(), int_type(0));
+    int_extra_.push_back(std::move(f));
+    return int_extra_.size() - 1;
+  }
+  // The index of the integer field `name`, or npos.
+  std::size_t find_int_field(std::string_view name) const {
+    for (std::size_t k = 0; k < int_extra_.size(); ++k)
+      if (int_extra_[k].name == name) return k;
+    return npos;
+  }
+  // Integer field k (as returned by add_int_field).
+  AlignedVector<int_type>& int_field(std::size_t k) { return int_extra_.at(k).data; }
+  const AlignedVector<int_type>& int_field(std::size_t k) const { return int_extra_.at(k).data; }
+  std::size_t int_field_count() const { return int_extra_.size(); }
+
   // Permutes every field so that the particle at old index perm[i] moves to
   // index i (a gather). perm must be a permutation of 0..size()-1.
   void reorder(std::span<const std::size_t> perm) {
@@ -125,6 +166,11 @@ class ParticleSet {
     for_each_array([&](AlignedVector<Real>& a) {
       for (std::size_t i = 0; i < perm.size(); ++i) scratch[i] = a[perm[i]];
       a.swap(scratch);
+    });
+    AlignedVector<int_type> int_scratch(int_extra_.empty() ? 0 : size());
+    for_each_int_array([&](AlignedVector<int_type>& a) {
+      for (std::size_t i = 0; i < perm.size(); ++i) int_scratch[i] = a[perm[i]];
+      a.swap(int_scratch);
     });
     AlignedVector<std::uint64_t> ids(size());
     for (std::size_t i = 0; i < perm.size(); ++i) ids[i] = id[perm[i]];
@@ -136,6 +182,11 @@ class ParticleSet {
   // The id array is not real-valued and is reached directly.
   std::vector<FieldView<const Real>> fields() const { return fields_impl<const Real>(*this); }
   std::vector<FieldView<Real>> fields() { return fields_impl<Real>(*this); }
+
+  // Every integer field in creation order (1 component each): what writers
+  // and checkpoints iterate over after the real fields.
+  std::vector<FieldView<const int_type>> int_fields() const { return int_fields_impl<const int_type>(*this); }
+  std::vector<FieldView<int_type>> int_fields() { return int_fields_impl<int_type>(*this); }
 
   // Built-in fields (see the units note above).
   Vec3Array<Real> position;           // x
@@ -153,6 +204,11 @@ class ParticleSet {
     int components = 1;
     FieldUse use = FieldUse::Output;
     std::array<AlignedVector<Real>, 3> data;
+  };
+  struct IntField {
+    std::string name;
+    FieldUse use = FieldUse::Output;
+    AlignedVector<int_type> data;
   };
 
   static bool is_builtin_name(std::string_view n) {
@@ -192,7 +248,15 @@ class ParticleSet {
     return out;
   }
 
+  template <class T, class Self>
+  static std::vector<FieldView<T>> int_fields_impl(Self& self) {
+    std::vector<FieldView<T>> out;
+    for (auto& f : self.int_extra_) out.push_back({f.name, 1, {f.data.data(), nullptr, nullptr}, f.use == FieldUse::Internal});
+    return out;
+  }
+
   std::vector<ExtraField> extra_;
+  std::vector<IntField> int_extra_;
 };
 
 }  // namespace swirl

@@ -7,7 +7,8 @@
 //
 // What a solver owns:
 //  - its fields: declare_fields() adds what it reads or writes beyond the
-//    built-in ones (density, a potential, a kind flag), before the first step;
+//    built-in ones (a potential: add_field; a particle kind or flag:
+//    add_int_field), before the first step;
 //  - its computation: add_acceleration() reads the state and ADDS into
 //    particles.acceleration (the stepper zeroed it). It never permutes the
 //    particles: the simulation owns the one particle order (a solver that
@@ -62,8 +63,9 @@ class Solver {
   // A short name for summaries, phases and messages, e.g. "sph".
   virtual std::string_view name() const = 0;
 
-  // Adds the fields this solver needs (ParticleSet::add_field); called once
-  // before the first evaluation and again after a checkpoint is read.
+  // Adds the fields this solver needs (ParticleSet::add_field,
+  // add_int_field); called once before the first evaluation and again after a
+  // checkpoint is read.
   virtual void declare_fields(ParticleSet<Real>& /*particles*/) {}
 
   // The particle order this solver needs (none by default).

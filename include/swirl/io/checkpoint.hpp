@@ -2,34 +2,46 @@
 // file, so that a run stopped and resumed ends bit-identical to one that never
 // stopped.
 //
-// Layout (little-endian), format version 2 (the same layout as version 1):
+// Layout (little-endian), format version 3:
 //   "SWIRLCKP"                          magic, 8 bytes
 //   u32 version, u32 real_bytes (4 | 8), u64 particles, u64 scene_hash,
 //   u64 step, f64 time
 //   u32 field_count, then per field: u32 name_length, name, u32 components
+//   u32 int_field_count, then per integer field: u32 name_length, name
 //   u32 value_count, then per value: u32 name_length, name, f64 value
-//   the fields' data in the order listed, component by component, in the
-//   particles' current memory order; then the ids (u64 each)
+//   the real fields' data in the order listed, component by component, in
+//   the particles' current memory order; then the integer fields' data (i32
+//   each) in the order listed; then the ids (u64 each)
 //   u64 checksum: FNV-1a 64 of every byte before it
 // Fields are every real field of the ParticleSet, output and internal alike
 // (positions, velocities, accelerations, previous accelerations, mass,
 // density, pressure, solver fields such as "potential", and the particle
-// order's reference positions when a Verlet skin is used); "values" carry the
-// state beyond the fields, each under its owner's prefix: the simulation's
-// clock ("clock.*": the adaptive controller's previous step and floor), the
-// stepper's and every solver's state ("sph.*", "self_gravity.*") and every
-// observer's ("frames.*", "diagnostics.*", "checkpoints.*") and where the run
-// ends ("run.end_step" or "run.end_time"; absent in files of earlier builds of
-// version 2, whose resume then ends at the scene's end), so that a resumed
-// run is bit-identical to one that never stopped (sim/simulation.hpp,
-// sim/observer.hpp). The step and the time reached are in the header.
+// order's reference positions when a Verlet skin is used), and every integer
+// field (one std::int32_t per particle, such as a particle kind); "values"
+// carry the state beyond the fields, each under its owner's prefix: the
+// simulation's clock ("clock.*": the adaptive controller's previous step and
+// floor), the stepper's and every solver's state ("sph.*", "self_gravity.*")
+// and every observer's ("frames.*", "diagnostics.*", "checkpoints.*") and
+// where the run ends ("run.end_step" or "run.end_time"; absent in files of
+// earlier builds of version 2, whose resume then ends at the scene's end), so
+// that a resumed run is bit-identical to one that never stopped
+// (sim/simulation.hpp, sim/observer.hpp). The step and the time reached are in
+// the header. Names are unique across real and integer fields.
 //
-// Version 2 (this one): the run's values under owner prefixes, written since
-// the solver/stepper/observer seams. Version 1 files (unprefixed "frames",
-// "next_frame", ...) are refused with a message saying so: resume them with the
-// swirl that wrote them. Whoever adds state that changes results adds it
-// through save_state()/load_state() of its owner; a change of layout or of the
-// meaning of a value bumps kCheckpointVersion.
+// Versions:
+//   3 (this one): version 2 plus the integer fields (their list after the real
+//     fields', their data after the real data).
+//   2: the run's values under owner prefixes, written since the
+//     solver/stepper/observer seams; no integer fields (neither
+//     int_field_count nor integer data). Still read: the file simply has no
+//     integer fields, so a run that declares one cannot resume from it (the
+//     field's values would be missing) and is refused with a message.
+//   1: the layout of version 2 with unprefixed values ("frames",
+//     "next_frame", ...): refused with a message saying so; resume it with the
+//     swirl that wrote it.
+// Whoever adds state that changes results adds it through
+// save_state()/load_state() of its owner; a change of layout or of the meaning
+// of a value bumps kCheckpointVersion (and says here what the old versions hold).
 #pragma once
 
 #include <cstdint>
@@ -42,7 +54,8 @@
 
 namespace swirl::io {
 
-inline constexpr std::uint32_t kCheckpointVersion = 2;
+inline constexpr std::uint32_t kCheckpointVersion = 3;                // what write_checkpoint writes
+inline constexpr std::uint32_t kOldestReadableCheckpointVersion = 2;  // the oldest read_checkpoint reads
 
 struct CheckpointHeader {
   std::uint32_t real_bytes = 8;  // 4 (float) or 8 (double)
@@ -50,6 +63,7 @@ struct CheckpointHeader {
   std::uint64_t scene_hash = 0;
   std::uint64_t step = 0;
   double time = 0;
+  std::uint32_t version = kCheckpointVersion;  // read: the file's; write_checkpoint always writes kCheckpointVersion
 };
 
 using CheckpointValues = std::vector<std::pair<std::string, double>>;
@@ -63,7 +77,9 @@ void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>
 CheckpointHeader read_checkpoint_header(const std::filesystem::path& path);
 
 // Reads a checkpoint into `particles`, whose fields are matched by name: a field
-// of the file missing from `particles` is added. Verifies the magic, version,
+// of the file missing from `particles` is added (with FieldUse::Output unless
+// it was declared before); an integer field of `particles` missing from the
+// file is refused (its values cannot be restored). Verifies the magic, version,
 // precision, sizes and checksum first; throws IoError naming the file and the
 // reason, and never allocates more than the file's size justifies.
 template <class Real>

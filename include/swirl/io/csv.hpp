@@ -1,6 +1,8 @@
 // CSV output of one frame: a header row naming the columns (id, x, y, z, then
-// every field, vector fields as name_x, name_y, name_z) and one row per
-// particle, values printed with enough digits to round-trip exactly.
+// every real field, vector fields as name_x, name_y, name_z, then every
+// integer field; internal fields are left out) and one row per particle,
+// values printed with enough digits to round-trip exactly (integers as
+// integers).
 #pragma once
 
 #include <filesystem>

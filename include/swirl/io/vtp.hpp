@@ -1,9 +1,10 @@
 // VTK XML PolyData (.vtp) output, and a reader for it.
 //
 // One file holds one frame: the particle positions as Points, one vertex cell
-// per particle (so ParaView draws them without a filter), and every field of the
-// ParticleSet plus "id" as PointData arrays named after the field. The time is a
-// FieldData array "TimeValue". Array data are "binary appended raw": after the
+// per particle (so ParaView draws them without a filter), and every output
+// field of the ParticleSet (real fields as Float32/Float64, integer fields as
+// Int32) plus "id" (UInt64) as PointData arrays named after the field;
+// internal fields are not written. The time is a FieldData array "TimeValue". Array data are "binary appended raw": after the
 // XML, an `_` and then, for each array, a UInt64 byte count and the
 // little-endian values, so positions and fields are written exactly.
 #pragma once
@@ -30,7 +31,7 @@ extern template void write_vtp<double>(const std::filesystem::path&, const Parti
 
 // One array read back from a .vtp file, values kept as the raw bytes written.
 struct VtpArray {
-  std::string type;     // VTK type name: "Float32", "Float64", "UInt64", "Int64"
+  std::string type;     // VTK type name: "Float32", "Float64", "Int32", "UInt64", "Int64", ...
   int components = 1;
   std::vector<std::byte> bytes;
 
