@@ -71,7 +71,7 @@ std::unique_ptr<Simulation<Real>> make_run(std::size_t n) {
   settings.box = boundary::BoxCollision<double>{{{0, 0, 0}, {1, 1, 1}}, 0.5};
   auto sim = std::make_unique<Simulation<Real>>(std::move(p), settings);
   sph::SphParameters params;
-  params.smoothing_length = sph::smoothing_length_for_neighbors(25, 1.0 / double(n));
+  params.smoothing_length = sph::smoothing_length_for_neighbours(25, 1.0 / double(n));
   params.sound_speed = 1;
   params.viscosity = 0.05;
   params.grid_skin = 0.2 * params.smoothing_length;
