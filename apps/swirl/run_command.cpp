@@ -44,7 +44,6 @@ struct RunArgs {
   std::size_t checkpoint_keep = 2;
   std::string resume;
   bool overwrite = false;
-  bool fixed_threads = false;
   std::uint64_t render_every = 0;  // draw every K-th frame while running (0: off)
 };
 
@@ -105,7 +104,6 @@ int run(const RunArgs& args) {
   }
   check_outputs(args, options.out_dir);
   options.threads = args.threads;
-  options.adapt_threads = !args.fixed_threads;
   if (args.steps > 0) options.steps = args.steps;
   if (args.until > 0) {
     // The step count the run must reach, ceil(T/dt), has to be one it can count.
@@ -181,9 +179,6 @@ void add_run_command(CLI::App& app, Commands& commands) {
   run_cmd->add_option("scene", args->scene, "Scene file (TOML)");
   run_cmd->add_option("--threads,-t", args->threads, "Threads (default: all cores, or OMP_NUM_THREADS)")
       ->check(thread_count());
-  run_cmd->add_flag("--fixed-threads", args->fixed_threads,
-                    "Use exactly that many threads every step (default: fewer while that is faster, e.g. when another "
-                    "process keeps a core busy; results are the same bits either way)");
   run_cmd->add_option("--out,-o", args->out, "Output directory (default: out/<scene name>)");
   auto* steps_opt = run_cmd->add_option("--steps", args->steps, "Number of steps to take, replacing the scene's end time")
       ->check(whole_number(1, kMaxSteps));

@@ -5,10 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
-#include <optional>
 #include <sstream>
 
-#include <omp.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -20,7 +18,6 @@
 #include "swirl/io/run_folder.hpp"
 #include "swirl/io/vtp.hpp"
 #include "swirl/parallel/for_blocks.hpp"
-#include "swirl/parallel/thread_governor.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/scene/validate.hpp"
 #include "swirl/sim/build.hpp"
@@ -588,14 +585,6 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
                           scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
   }
   auto running = [&] { return end.to_time ? sim.time() < end.time : sim.step_count() < end.step; };
-  // Fewer threads while that is faster (a core busy with another process).
-  const int allowed_threads = parallel::thread_count();
-  std::optional<parallel::ThreadGovernor> governor;
-  if (options.adapt_threads && allowed_threads > 1) governor.emplace(allowed_threads);
-  struct RestoreThreads {  // also when a step throws
-    int n;
-    ~RestoreThreads() { omp_set_num_threads(n); }
-  } restore_threads{allowed_threads};
 
   try {
     if (!options.resume) sim.start();  // solvers fill their fields (density, potential) here
@@ -608,15 +597,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
         for (const Observer<Real>* o : observers)
           if (const auto t = o->next_time(sim); t && (!land || *t < *land)) land = t;
       }
-      if (!governor) {
-        sim.step(land);
-      } else {
-        parallel::set_thread_count(governor->threads());
-        const auto began = std::chrono::steady_clock::now();
-        sim.step(land);
-        governor->record(std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count());
-        parallel::set_thread_count(allowed_threads);  // the observers' passes (output) use every thread
-      }
+      sim.step(land);
       for (Observer<Real>* o : observers) o->on_step(sim);
       if (options.stop && options.stop->load()) {
         checkpoints->write(sim);
@@ -646,8 +627,6 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   for (const auto& s : sim.solvers()) s->add_metrics(summary.metrics);
   if (const auto error = diagnostics->energy_error()) summary.metrics.emplace_back("relative_energy_error", *error);
   if (sim.order().active()) summary.metrics.emplace_back("sorts", double(sim.order().sorts()));
-  if (governor && governor->steps_below_max() > 0)  // steps run on fewer threads (busy cores, or probes)
-    summary.metrics.emplace_back("fewer_threads_share", double(governor->steps_below_max()) / double(governor->steps()));
   if (adaptive && progress->dt_max() > 0) {  // landing steps included
     summary.metrics.emplace_back("smallest_dt", progress->dt_min());
     summary.metrics.emplace_back("largest_dt", progress->dt_max());

@@ -32,16 +32,6 @@ TEST_F(Restart, SphResumedWithOtherThreadsEndsBitIdentical) {
 // A Verlet skin keeps the particle order between sorts; the order's reference
 // positions travel in the checkpoint, so the resumed run sorts exactly where
 // the uninterrupted one does.
-// The thread governor (fewer threads while that is faster) changes speed only:
-// a run that it moves between thread counts (its probes start after 64 steps)
-// writes the same bits as one on a fixed count.
-TEST_F(Restart, TheThreadGovernorChangesNoBitOfTheResults) {
-  const std::string common = kExamples + "random_box.toml --set particles=1000 --steps 150 --threads 2";
-  ASSERT_EQ(swirl("run " + common + " --out " + (dir_ / "adaptive").string()).status, 0);
-  ASSERT_EQ(swirl("run " + common + " --fixed-threads --out " + (dir_ / "fixed").string()).status, 0);
-  expect_same_outputs(dir_ / "adaptive", dir_ / "fixed");
-}
-
 TEST_F(Restart, SphWithASkinResumesBitIdentically) {
   const std::string skin = kSph + " --set sph.grid.skin=0.008";
   const auto a = swirl("run " + skin + " --steps 30 --threads 2 --out " + (dir_ / "a").string());

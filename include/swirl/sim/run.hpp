@@ -48,10 +48,6 @@ using FrameHook = std::function<void(const std::filesystem::path& frame, double 
 struct RunOptions {
   std::filesystem::path out_dir = "out";
   int threads = 0;                      // 0: OpenMP's default (OMP_NUM_THREADS or all cores)
-  // Use fewer of those threads while that is faster (another process busy on
-  // a core; parallel/thread_governor.hpp); false: exactly `threads` every step.
-  // Either way the results are the same bits.
-  bool adapt_threads = true;
   std::optional<std::uint64_t> steps;   // steps to take (from the start, or from the checkpoint on resume)
   std::optional<double> until;          // run until this simulated time instead of the scene's end
 
