@@ -10,11 +10,13 @@
 
 #include <CLI/CLI.hpp>
 
+#include "swirl/sim/run.hpp"
+
 namespace swirl::cli {
 
-// The most steps a run can count: a step's time n·dt is exact in a double only
-// up to 2^53 steps, and a step count beyond that could never be reached anyway.
-inline constexpr std::uint64_t kMaxSteps = std::uint64_t{1} << 53;
+// The most steps a run can count (sim/run.hpp: n·dt is exact in a double only
+// up to 2^53 steps, and a count beyond that could never be reached anyway).
+using sim::kMaxSteps;
 
 // The most of anything else the CLI counts (particles, iterations, buckets):
 // what an int holds, far beyond what a run on one machine can use.

@@ -437,16 +437,13 @@ struct RunEnd {
   std::uint64_t step = 0;  // !to_time
   double time = 0;         // to_time
 
-  // The largest step a run counts (time = step·dt stays exact in a double).
-  static constexpr std::uint64_t kMaxStep = std::uint64_t{1} << 53;
-
   // From the flags (--steps: that many more from `from_step`), else what the
   // checkpoint remembers, else the scene.
   static RunEnd choose(const scene::Scene& scene, const RunOptions& options, std::uint64_t from_step, double from_time,
                        const NamedValues* saved) {
     RunEnd e;
     if (options.steps) {
-      if (*options.steps > kMaxStep - std::min(from_step, kMaxStep))
+      if (*options.steps > kMaxSteps - std::min(from_step, kMaxSteps))
         throw std::invalid_argument(fmt::format("--steps {}: from step {} that passes the 2^53 steps a run can count",
                                                 *options.steps, from_step));
       e.step = from_step + *options.steps;

@@ -146,7 +146,6 @@ TEST_F(Safety, Finding6_AResumeEndsWhereTheRunWasToldToEnd) {
   r = swirl("run --resume " + run.string());
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.out.find("steps            10 (t = 0.2"), std::string::npos) << r.out;
-  EXPECT_EQ(r.err.find("progress 1000%"), std::string::npos);
   for (auto at = r.err.find("progress"); at != std::string::npos; at = r.err.find("progress", at + 1)) {
     const int percent = std::stoi(r.err.substr(at + 8, 5));
     EXPECT_LE(percent, 100) << r.err;

@@ -45,6 +45,10 @@ using ClaimFile = std::function<std::filesystem::path(const std::filesystem::pat
 // simulated time, and the claim for any file the hook writes itself.
 using FrameHook = std::function<void(const std::filesystem::path& frame, double time, const ClaimFile& claim)>;
 
+// The most steps a run counts: time = step·dt stays exact in a double. The
+// CLI's flags and a resume's remembered end are held to it.
+inline constexpr std::uint64_t kMaxSteps = std::uint64_t{1} << 53;
+
 struct RunOptions {
   std::filesystem::path out_dir = "out";
   int threads = 0;                      // 0: OpenMP's default (OMP_NUM_THREADS or all cores)

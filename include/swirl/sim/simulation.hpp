@@ -375,7 +375,7 @@ class Simulation {
         fmt::format("particle id {} has a non-finite {} (x = ({}, {}, {}), v = ({}, {}, {}))", particles_.id[i], names,
                     particles_.position.x[i], particles_.position.y[i], particles_.position.z[i],
                     particles_.velocity.x[i], particles_.velocity.y[i], particles_.velocity.z[i]);
-    if (clock_.step == 0 && last_dt_ == 0)  // start(): the forces of the initial state, no step taken
+    if (!started_)  // start(): the forces of the initial state, no step taken
       throw SimulationError(
           fmt::format("before the first step: blow-up: the forces of the initial state are not finite: {}; no time "
                       "step is involved: two particles at the same place without softening, or an initial value out "
