@@ -527,7 +527,7 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
   const KernelPath path = settings_.simd_kernels ? KernelPath::Simd : KernelPath::Scalar;
   parallel::for_blocks("linear_octree_group_walk", groups, 1, [&](std::size_t k, std::size_t, std::size_t) {
     const std::size_t g = schedule_[k];
-    const auto thread = std::size_t(omp_get_thread_num());
+    const auto thread = std::size_t(parallel::thread_index());
     if (thread >= lists_.size()) throw std::logic_error("linear octree: more threads than list buffers");
     GroupLists& l = lists_[thread];
     const std::uint64_t popped = walk_group(g, l);

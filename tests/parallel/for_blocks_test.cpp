@@ -39,13 +39,16 @@ TEST(ForBlocks, VisitsEveryIndexExactlyOnceInFixedBlocks) {
 
 TEST(ForBlocks, UsesSeveralThreadsWhenAsked) {
   swirl::parallel::set_thread_count(2);
+  // Blocks long enough that the worker wakes before the caller has run them all.
   std::atomic<int> max_seen{0};
-  for_blocks("test", 64, 1, [&](std::size_t, std::size_t, std::size_t) {
-    int t = omp_get_num_threads();
-    int prev = max_seen.load();
-    while (t > prev && !max_seen.compare_exchange_weak(prev, t)) {}
-  });
-  EXPECT_EQ(max_seen.load(), 2);
+  for (int attempt = 0; attempt < 100 && max_seen.load() < 1; ++attempt)
+    for_blocks("test", 64, 1, [&](std::size_t, std::size_t, std::size_t) {
+      const int t = swirl::parallel::thread_index();
+      int prev = max_seen.load();
+      while (t > prev && !max_seen.compare_exchange_weak(prev, t)) {}
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    });
+  EXPECT_EQ(max_seen.load(), 1);
 }
 
 TEST(ReduceBlocks, FloatingPointSumIsBitIdenticalForAnyThreadCount) {
@@ -151,6 +154,75 @@ TEST(ReduceBlocksPinned, EqualsTheWorkpoolsFoldBitForBit) {
     swirl::parallel::set_thread_count(threads);
     EXPECT_EQ(reduce_blocks_pinned("sum", values.size(), 61, 0.0, block_sum, add), reference) << threads;
   }
+}
+
+// The pool's promise: the caller waits for blocks, never for threads. With
+// the workers held (as if the operating system never scheduled them), every
+// loop still completes, on the caller alone, in both schedules; released,
+// they take part again.
+TEST(ThreadPool, ALoopCompletesWithoutWorkersThatNeverStarted) {
+  auto& pool = swirl::parallel::pool();
+  for (int threads : {2, 4}) {
+    swirl::parallel::set_thread_count(threads);
+    pool.hold_workers(true);
+    for (int call = 0; call < 50; ++call) {
+      std::vector<int> hits(300, 0);
+      std::atomic<int> highest{0};
+      const auto body = [&](std::size_t b, std::size_t e, std::size_t) {
+        for (std::size_t i = b; i < e; ++i) ++hits[i];
+        highest = std::max(highest.load(), swirl::parallel::thread_index());
+      };
+      if (call % 2) for_blocks("held", hits.size(), 3, body);
+      else for_blocks_pinned("held", hits.size(), 3, body);
+      for (int h : hits) ASSERT_EQ(h, 1);
+      ASSERT_EQ(highest.load(), 0) << "a held worker ran a block";
+    }
+    pool.hold_workers(false);
+  }
+  std::atomic<int> highest{0};
+  for (int attempt = 0; attempt < 100 && highest.load() == 0; ++attempt)
+    for_blocks("released", 16, 1, [&](std::size_t, std::size_t, std::size_t) {
+      highest = std::max(highest.load(), swirl::parallel::thread_index());
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    });
+  EXPECT_GT(highest.load(), 0);
+}
+
+// A loop started inside a block, or from a second thread while the pool is
+// busy, runs serially on its caller, with the same blocks.
+TEST(ThreadPool, NestedAndConcurrentLoopsRunSeriallyOnTheirCaller) {
+  swirl::parallel::set_thread_count(3);
+  std::vector<std::atomic<int>> hits(40 * 40);
+  for_blocks("outer", 40, 1, [&](std::size_t i, std::size_t, std::size_t) {
+    const int me = swirl::parallel::thread_index();
+    for_blocks("inner", 40, 1, [&](std::size_t j, std::size_t, std::size_t) {
+      EXPECT_EQ(swirl::parallel::thread_index(), me);
+      ++hits[i * 40 + j];
+    });
+  });
+  for (auto& h : hits) EXPECT_EQ(h.load(), 1);
+
+  std::vector<double> values(200000);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 1.0 / double(i + 1);
+  const auto sum = [&] {
+    return reduce_blocks(
+        "sum", values.size(), 101, 0.0,
+        [&](std::size_t b, std::size_t e) {
+          double s = 0;
+          for (std::size_t i = b; i < e; ++i) s += values[i];
+          return s;
+        },
+        [](double x, double y) { return x + y; });
+  };
+  const double reference = sum();
+  std::vector<double> results(4 * 50);
+  std::vector<std::thread> callers;
+  for (int t = 0; t < 4; ++t)
+    callers.emplace_back([&, t] {
+      for (int k = 0; k < 50; ++k) results[std::size_t(t * 50 + k)] = sum();
+    });
+  for (auto& c : callers) c.join();
+  for (double r : results) EXPECT_EQ(r, reference);
 }
 
 }  // namespace

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "sph_test_support.hpp"
-#include "swirl/sph/diagnostics.hpp"
 
 namespace {
 
@@ -122,8 +121,8 @@ TYPED_TEST(GridStrategyTest, TotalsAgreeWithTheHashAfter100Steps) {
     grid->step();
   }
   const Vec3d g{0, 0, -9.81};
-  const auto da = sph::fluid_diagnostics(hash->particles(), g, 1000, 64);
-  const auto db = sph::fluid_diagnostics(grid->particles(), g, 1000, 64);
+  const auto da = swirl::testing::fluid_diagnostics(hash->particles(), g, 1000, 64);
+  const auto db = swirl::testing::fluid_diagnostics(grid->particles(), g, 1000, 64);
   ASSERT_GT(da.kinetic_energy, 0.0);
   EXPECT_NEAR(db.kinetic_energy, da.kinetic_energy, 0.01 * da.kinetic_energy);
   EXPECT_NEAR(db.potential_energy, da.potential_energy, 0.01 * std::abs(da.potential_energy));

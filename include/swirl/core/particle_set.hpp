@@ -92,12 +92,14 @@ class ParticleSet {
 
   // Calls f(AlignedVector<Real>&) for every real array, built-in and extra, in
   // fields() order (component by component). The ids are not included.
+  // Allocates nothing (unlike fields()): cheap enough for a per-block pass.
   template <class F>
   void for_each_array(F&& f) {
-    for (auto* v : {&position, &velocity, &acceleration, &acceleration_prev})
-      for (int a = 0; a < 3; ++a) f((*v)[a]);
-    f(mass); f(density); f(pressure);
-    for (auto& e : extra_) for (int c = 0; c < e.components; ++c) f(e.data[static_cast<std::size_t>(c)]);
+    for_each_array_impl(*this, f);
+  }
+  template <class F>
+  void for_each_array(F&& f) const {
+    for_each_array_impl(*this, f);
   }
 
   // Calls f(AlignedVector<int_type>&) for every integer field, in int_fields() order.
@@ -224,6 +226,17 @@ class ParticleSet {
       if (p >= perm.size() || seen[p]) throw std::invalid_argument("reorder: not a permutation");
       seen[p] = true;
     }
+  }
+
+  template <class Self, class F>
+  static void for_each_array_impl(Self& self, F& f) {
+    for (auto* v : {&self.position, &self.velocity, &self.acceleration, &self.acceleration_prev})
+      for (int a = 0; a < 3; ++a) f((*v)[a]);
+    f(self.mass);
+    f(self.density);
+    f(self.pressure);
+    for (auto& e : self.extra_)
+      for (int c = 0; c < e.components; ++c) f(e.data[static_cast<std::size_t>(c)]);
   }
 
   template <class T, class Self>

@@ -72,20 +72,18 @@ template <class Real>
 StepScan scan_block(const ParticleSet<Real>& p, std::size_t begin, std::size_t end, const ScanNeeds& needs) {
   StepScan s;
   // x·0 is 0 for finite x and NaN otherwise, so a plain sum finds any NaN or infinity.
-  for (const auto& f : p.fields()) {
-    for (int c = 0; c < f.components; ++c) {
-      const Real* x = f.data[static_cast<std::size_t>(c)];
-      Real poison = 0;
+  p.for_each_array([&](const AlignedVector<Real>& field) {
+    const Real* x = field.data();
+    Real poison = 0;
 #pragma omp simd reduction(+ : poison)
-      for (std::size_t i = begin; i < end; ++i) poison += x[i] * Real(0);
-      if (poison == Real(0)) continue;
-      for (std::size_t i = begin; i < std::min(end, s.non_finite); ++i)
-        if (!std::isfinite(x[i])) {
-          s.non_finite = i;
-          break;
-        }
-    }
-  }
+    for (std::size_t i = begin; i < end; ++i) poison += x[i] * Real(0);
+    if (poison == Real(0)) return;
+    for (std::size_t i = begin; i < std::min(end, s.non_finite); ++i)
+      if (!std::isfinite(x[i])) {
+        s.non_finite = i;
+        break;
+      }
+  });
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
   const Real *ax = p.acceleration.x.data(), *ay = p.acceleration.y.data(), *az = p.acceleration.z.data();
   // In Real: twice the vector width of double for float, and precise enough for a limit.

@@ -2,9 +2,9 @@
 // table build (count, prefix sum into the offset table, scatter; section 4.2.2),
 // which the thesis ran serially on the PPE.
 //
-// Each thread counts the keys of one contiguous chunk, the per-(key, chunk)
-// counts are prefix-summed in key-major order, and each thread scatters its
-// chunk in index order. The result is THE stable order (ties by index), so it is
+// The items are cut into contiguous chunks (pinned blocks of the pool); each
+// chunk's keys are counted, the per-(key, chunk) counts are prefix-summed in
+// key-major order, and each chunk is scattered in index order. The result is THE stable order (ties by index), so it is
 // identical for any thread count.
 #pragma once
 
@@ -16,7 +16,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include <omp.h>
+#include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::parallel {
 
@@ -31,53 +31,49 @@ class CountingSort {
     if (key_count == 0) throw std::invalid_argument("counting sort: key_count must be at least 1");
     if (n > 0xffffffffu) throw std::invalid_argument("counting sort: more than 2^32 - 1 items");
     const std::size_t m = key_count;
-    const int wanted = std::max(1, std::min<int>(omp_get_max_threads(), static_cast<int>(n / 4096) + 1));
+    // One chunk per thread (each costs key_count counters to clear and sum);
+    // a descheduled thread's chunk is taken by another, and the count changes
+    // the speed, never the result.
+    const std::size_t chunks = std::min<std::size_t>(n / 4096 + 1, static_cast<std::size_t>(thread_count()));
+    auto chunk_begin = [&](std::size_t c) { return n * c / chunks; };
+    // Keys are cut into as many contiguous ranges for the prefix sum.
+    auto key_begin = [&](std::size_t c) { return m * c / chunks; };
     offsets_.assign(m + 1, 0);
     order_.resize(n);
-    int chunks = 1;  // one per thread of the team actually granted
-    std::vector<std::uint32_t> range_total;
-    auto chunk_begin = [&](int c) { return n * static_cast<std::size_t>(c) / static_cast<std::size_t>(chunks); };
+    counts_.assign(chunks * m, 0);
+    range_total_.assign(chunks + 1, 0);
 
-#pragma omp parallel num_threads(wanted)
-    {
-#pragma omp single
-      {
-        chunks = omp_get_num_threads();
-        counts_.assign(static_cast<std::size_t>(chunks) * m, 0);
-        range_total.assign(static_cast<std::size_t>(chunks) + 1, 0);
-      }
-      const int c = omp_get_thread_num();
-      std::uint32_t* count = counts_.data() + static_cast<std::size_t>(c) * m;
+    for_blocks_pinned("counting_sort_count", chunks, 1, [&](std::size_t c, std::size_t, std::size_t) {
+      std::uint32_t* count = counts_.data() + c * m;
       for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i) {
         assert(keys[i] < key_count);
         ++count[keys[i]];
       }
-#pragma omp barrier
-      // Keys are split among threads in contiguous ranges for the prefix sum.
-      const std::size_t k0 = m * static_cast<std::size_t>(c) / static_cast<std::size_t>(chunks);
-      const std::size_t k1 = m * static_cast<std::size_t>(c + 1) / static_cast<std::size_t>(chunks);
+    });
+    for_blocks_pinned("counting_sort_range_totals", chunks, 1, [&](std::size_t c, std::size_t, std::size_t) {
       std::uint32_t sum = 0;
-      for (std::size_t k = k0; k < k1; ++k)
-        for (int t = 0; t < chunks; ++t) sum += counts_[static_cast<std::size_t>(t) * m + k];
-      range_total[static_cast<std::size_t>(c) + 1] = sum;
-#pragma omp barrier
-#pragma omp single
-      for (int t = 0; t < chunks; ++t) range_total[static_cast<std::size_t>(t) + 1] += range_total[static_cast<std::size_t>(t)];
-      // (implicit barrier after single)
-      std::uint32_t running = range_total[static_cast<std::size_t>(c)];
-      for (std::size_t k = k0; k < k1; ++k) {
+      for (std::size_t k = key_begin(c); k < key_begin(c + 1); ++k)
+        for (std::size_t t = 0; t < chunks; ++t) sum += counts_[t * m + k];
+      range_total_[c + 1] = sum;
+    });
+    for (std::size_t t = 0; t < chunks; ++t) range_total_[t + 1] += range_total_[t];
+    for_blocks_pinned("counting_sort_offsets", chunks, 1, [&](std::size_t c, std::size_t, std::size_t) {
+      std::uint32_t running = range_total_[c];
+      for (std::size_t k = key_begin(c); k < key_begin(c + 1); ++k) {
         offsets_[k] = running;
-        for (int t = 0; t < chunks; ++t) {
-          std::uint32_t& slot = counts_[static_cast<std::size_t>(t) * m + k];
+        for (std::size_t t = 0; t < chunks; ++t) {
+          std::uint32_t& slot = counts_[t * m + k];
           const std::uint32_t here = slot;
           slot = running;  // becomes chunk t's next write position for key k
           running += here;
         }
       }
-#pragma omp barrier
+    });
+    for_blocks_pinned("counting_sort_scatter", chunks, 1, [&](std::size_t c, std::size_t, std::size_t) {
+      std::uint32_t* count = counts_.data() + c * m;
       for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i)
         order_[count[keys[i]]++] = static_cast<std::uint32_t>(i);
-    }
+    });
     offsets_[m] = static_cast<std::uint32_t>(n);
   }
 
@@ -88,6 +84,7 @@ class CountingSort {
   std::vector<std::uint32_t> counts_;   // per (chunk, key), reused between sorts
   std::vector<std::uint32_t> offsets_;  // key_count + 1
   std::vector<std::uint32_t> order_;    // n
+  std::vector<std::uint32_t> range_total_;  // chunk + 1: items with keys below each key range
 };
 
 }  // namespace swirl::parallel

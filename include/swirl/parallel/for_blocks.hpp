@@ -1,8 +1,8 @@
 // The one wrapper through which every per-particle pass runs in parallel.
 //
 // It is the thesis's workpool (section 4, Algorithm 2) on today's cores: the
-// index range is cut into fixed work blocks of `block_size` items, and OpenMP
-// threads take blocks dynamically. Block boundaries depend only on n and
+// index range is cut into fixed work blocks of `block_size` items, and the
+// threads of swirl's pool (thread_pool.hpp) take blocks dynamically. Block boundaries depend only on n and
 // block_size, never on the thread count, so a pass whose blocks write disjoint
 // data (gather, not scatter) gives bit-identical results on any thread count;
 // reduce_blocks() keeps that promise for reductions by combining per-block
@@ -18,11 +18,13 @@
 // docs/performance/sph-grid.md). A thread that has finished its own run then
 // takes the unstarted blocks of the others' runs, so a thread that the
 // operating system deschedules (another process busy on its core) delays the
-// pass by at most the block it holds, not by its whole run: a plain static
-// schedule collapsed below one thread's speed on a loaded 2-core machine.
+// pass by at most the block it holds, not by its whole run, and the caller
+// never waits for a thread that has not started: OpenMP's static schedule, and
+// then its end-of-region barrier, collapsed below one thread's speed on a
+// loaded 2-core machine.
 //
-// An exception thrown inside a block is caught (OpenMP would terminate the
-// program), the loop finishes, and the first one is rethrown with the kernel's
+// An exception thrown inside a block is caught (it must not escape a pool
+// thread), the loop finishes, and the first one is rethrown with the kernel's
 // name prepended.
 #pragma once
 
@@ -40,17 +42,33 @@
 
 #include <omp.h>
 
+#include "swirl/parallel/thread_pool.hpp"
+
 namespace swirl::parallel {
 
-// Threads the next parallel loop will use.
-inline int thread_count() { return omp_get_max_threads(); }
-
-// The most threads swirl starts. OpenMP starts every thread it is asked for,
-// and tens of thousands exhaust the memory for their stacks: the runtime then
-// crashes (SIGSEGV) instead of reporting an error. More than 4 threads per
-// hardware thread never speed a pass up; 64 at least still lets a small
-// machine test that results do not depend on the thread count.
+// The most threads swirl starts. Every thread costs a stack, and tens of
+// thousands exhaust the memory for them. More than 4 threads per hardware
+// thread never speed a pass up; 64 at least still lets a small machine test
+// that results do not depend on the thread count.
 inline int max_thread_count() { return std::clamp(4 * omp_get_num_procs(), 64, 1024); }
+
+// The pool that runs every parallel pass, started on first use with OpenMP's
+// default thread count (OMP_NUM_THREADS, else one per processor).
+inline detail::ThreadPool& pool() {
+  static detail::ThreadPool& threads = []() -> detail::ThreadPool& {
+    auto& p = detail::ThreadPool::instance();
+    p.resize(std::min(omp_get_max_threads(), max_thread_count()));
+    return p;
+  }();
+  return threads;
+}
+
+// Threads the next parallel loop will use.
+inline int thread_count() { return pool().size(); }
+
+// This thread's index in the running loop: 0 for the caller, 1..thread_count()-1
+// for the pool's workers (a per-thread scratch buffer's index).
+inline int thread_index() { return detail::ThreadPool::thread_index(); }
 
 // Sets the threads used by later loops; 1 <= n <= max_thread_count(), else
 // std::invalid_argument.
@@ -60,6 +78,7 @@ inline void set_thread_count(int n) {
     throw std::invalid_argument("thread count " + std::to_string(n) + " is more than the " +
                                 std::to_string(max_thread_count()) + " threads swirl starts on this machine");
   omp_set_num_threads(n);
+  pool().resize(n);
 }
 
 // OMP_NUM_THREADS (or anything else that set OpenMP's default) above
@@ -69,6 +88,7 @@ inline std::string clamp_default_thread_count() {
   const int asked = omp_get_max_threads(), max = max_thread_count();
   if (asked <= max) return {};
   omp_set_num_threads(max);
+  pool().resize(max);
   return "OpenMP was asked for " + std::to_string(asked) + " threads (OMP_NUM_THREADS); using " +
          std::to_string(max) + ", the most swirl starts on this machine";
 }
@@ -116,39 +136,11 @@ void run_blocks(Schedule schedule, std::string_view kernel, std::size_t n, std::
       error.capture();
     }
   };
-  if (schedule == Schedule::Pinned) {
-    const int wanted = static_cast<int>(std::min<std::int64_t>(omp_get_max_threads(), blocks));
-    if (wanted <= 1) {
-      for (std::int64_t b = 0; b < blocks; ++b) run(b);
-      error.rethrow(kernel);
-      return;
-    }
-    // Run r is blocks [blocks·r/T, blocks·(r+1)/T); claimed[r] counts the
-    // blocks of run r handed out, by its owner first, then by any thread done
-    // with its own run. Each block runs exactly once, whoever runs it.
-    struct alignas(64) Claimed {
-      std::atomic<std::int64_t> count{0};
-    };
-    std::vector<Claimed> claimed(static_cast<std::size_t>(wanted));
-#pragma omp parallel num_threads(wanted)
-    {
-      const std::int64_t threads = omp_get_num_threads(), self = omp_get_thread_num();
-      for (std::int64_t k = 0; k < threads; ++k) {
-        const std::int64_t r = (self + k) % threads;
-        const std::int64_t first = blocks * r / threads, last = blocks * (r + 1) / threads;
-        auto& counter = claimed[static_cast<std::size_t>(r)].count;
-        // A run already taken costs one load, not a fetch_add, to skip.
-        while (first + counter.load(std::memory_order_relaxed) < last) {
-          const std::int64_t b = first + counter.fetch_add(1, std::memory_order_relaxed);
-          if (b >= last) break;
-          run(b);
-        }
-      }
-    }
-  } else {
-#pragma omp parallel for schedule(dynamic, 1)
-    for (std::int64_t b = 0; b < blocks; ++b) run(b);
-  }
+  // Pinned: run t of the job is thread t's, the same blocks on every call.
+  auto& threads = pool();
+  const std::int64_t runs = schedule == Schedule::Pinned ? std::min<std::int64_t>(threads.size(), blocks) : 1;
+  threads.run(blocks, runs, [](void* context, std::int64_t b) { (*static_cast<decltype(run)*>(context))(b); },
+              const_cast<void*>(static_cast<const void*>(&run)));
   error.rethrow(kernel);
 }
 

@@ -7,7 +7,8 @@
 // kDigitBits bits, least significant first; a digit on which every key agrees
 // costs one counting read and no scatter. Each pass is a parallel stable
 // counting sort (per-chunk histograms, prefix sum in digit-major order, each
-// chunk scatters its own items in order), so the result is THE stable order:
+// chunk scatters its own items in order; the chunks run as pinned blocks of the
+// pool, so no pass waits at a barrier for a descheduled thread), so the result is THE stable order:
 // identical for any thread count and any chunking.
 //
 // Afterwards order()[j] is the index of the j-th smallest key and keys()[j] its
@@ -24,9 +25,8 @@
 #include <type_traits>
 #include <vector>
 
-#include <omp.h>
-
 #include "swirl/core/aligned.hpp"
+#include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::parallel {
 
@@ -49,70 +49,61 @@ class RadixSort {
     spare_keys_.resize(n);
     spare_order_.resize(n);
     const Key mask = key_bits == 8 * sizeof(Key) ? ~Key{0} : static_cast<Key>((Key{1} << key_bits) - 1);
-    const int wanted = std::max(1, std::min<int>(omp_get_max_threads(), static_cast<int>(n / 8192) + 1));
-    int chunks = 1;
-    auto chunk_begin = [&](int c) { return n * static_cast<std::size_t>(c) / static_cast<std::size_t>(chunks); };
+    // Chunks of at least 8192 items, a few per thread so that a thread that
+    // is descheduled leaves chunks for the others to take; the count changes
+    // the speed, never the (unique, stable) result.
+    const std::size_t chunks =
+        std::min<std::size_t>(n / 8192 + 1, static_cast<std::size_t>(4 * thread_count()));
+    auto chunk_begin = [&](std::size_t c) { return n * c / chunks; };
+    counts_.assign(chunks * kBuckets, 0);
     bool first_pass = true;  // reads the caller's keys and the identity order
-
-#pragma omp parallel num_threads(wanted)
-    {
-#pragma omp single
-      {
-        chunks = omp_get_num_threads();
-        counts_.assign(static_cast<std::size_t>(chunks) * kBuckets, 0);
-      }
-      const int c = omp_get_thread_num();
-      const std::size_t begin = chunk_begin(c), end = chunk_begin(c + 1);
-      std::uint32_t* count = counts_.data() + static_cast<std::size_t>(c) * kBuckets;
-      for (unsigned shift = 0; shift < key_bits; shift += kDigitBits) {
-        const Key* in_keys = first_pass ? keys.data() : keys_.data();
+    for (unsigned shift = 0; shift < key_bits; shift += kDigitBits) {
+      const Key* in_keys = first_pass ? keys.data() : keys_.data();
+      for_blocks_pinned("radix_sort_count", chunks, 1, [&](std::size_t c, std::size_t, std::size_t) {
+        std::uint32_t* count = counts_.data() + c * kBuckets;
         std::fill(count, count + kBuckets, 0u);
-        for (std::size_t i = begin; i < end; ++i) ++count[((in_keys[i] & mask) >> shift) & (kBuckets - 1)];
-#pragma omp barrier
-#pragma omp single
-        {
-          // Prefix sum in digit-major, chunk-minor order: chunk t's items with
-          // digit d follow those of chunks < t with the same digit.
-          std::uint32_t running = 0;
-          skip_ = false;
-          for (std::size_t d = 0; d < kBuckets; ++d) {
-            std::uint32_t with_digit = 0;
-            for (int t = 0; t < chunks; ++t) {
-              std::uint32_t& slot = counts_[static_cast<std::size_t>(t) * kBuckets + d];
-              const std::uint32_t here = slot;
-              slot = running;
-              running += here;
-              with_digit += here;
-            }
-            if (with_digit == n) skip_ = true;  // every key has digit d: the pass would not move anything
-          }
+        for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i)
+          ++count[((in_keys[i] & mask) >> shift) & (kBuckets - 1)];
+      });
+      // Prefix sum in digit-major, chunk-minor order: chunk t's items with
+      // digit d follow those of chunks < t with the same digit.
+      std::uint32_t running = 0;
+      bool skip = false;
+      for (std::size_t d = 0; d < kBuckets; ++d) {
+        std::uint32_t with_digit = 0;
+        for (std::size_t t = 0; t < chunks; ++t) {
+          std::uint32_t& slot = counts_[t * kBuckets + d];
+          const std::uint32_t here = slot;
+          slot = running;
+          running += here;
+          with_digit += here;
         }
-        if (!skip_) {
-          Key* out_keys = spare_keys_.data();
-          std::uint32_t* out_order = spare_order_.data();
-          const std::uint32_t* in_order = order_.data();
-          for (std::size_t i = begin; i < end; ++i) {
-            const Key k = in_keys[i] & mask;
-            const std::uint32_t to = count[(k >> shift) & (kBuckets - 1)]++;
-            out_keys[to] = k;
-            out_order[to] = first_pass ? static_cast<std::uint32_t>(i) : in_order[i];
-          }
-#pragma omp barrier
-#pragma omp single
-          {
-            keys_.swap(spare_keys_);
-            order_.swap(spare_order_);
-            first_pass = false;
-          }
-        }
-        // (the single above, or the prefix-sum single when skipping, ends with a barrier)
+        if (with_digit == n) skip = true;  // every key has digit d: the pass would not move anything
       }
-      if (first_pass) {  // every digit was skipped: the input is already in order
-        for (std::size_t i = begin; i < end; ++i) {
+      if (skip) continue;
+      Key* out_keys = spare_keys_.data();
+      std::uint32_t* out_order = spare_order_.data();
+      const std::uint32_t* in_order = order_.data();
+      for_blocks_pinned("radix_sort_scatter", chunks, 1, [&](std::size_t c, std::size_t, std::size_t) {
+        std::uint32_t* count = counts_.data() + c * kBuckets;
+        for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i) {
+          const Key k = in_keys[i] & mask;
+          const std::uint32_t to = count[(k >> shift) & (kBuckets - 1)]++;
+          out_keys[to] = k;
+          out_order[to] = first_pass ? static_cast<std::uint32_t>(i) : in_order[i];
+        }
+      });
+      keys_.swap(spare_keys_);
+      order_.swap(spare_order_);
+      first_pass = false;
+    }
+    if (first_pass) {  // every digit was skipped: the input is already in order
+      for_blocks_pinned("radix_sort_copy", chunks, 1, [&](std::size_t c, std::size_t, std::size_t) {
+        for (std::size_t i = chunk_begin(c); i < chunk_begin(c + 1); ++i) {
           keys_[i] = keys[i] & mask;
           order_[i] = static_cast<std::uint32_t>(i);
         }
-      }
+      });
     }
   }
 
@@ -125,7 +116,6 @@ class RadixSort {
   AlignedVector<Key> keys_, spare_keys_;
   AlignedVector<std::uint32_t> order_, spare_order_;
   std::vector<std::uint32_t> counts_;  // per (chunk, digit); after the prefix sum, each chunk's next slot
-  bool skip_ = false;
 };
 
 }  // namespace swirl::parallel
