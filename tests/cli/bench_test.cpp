@@ -112,12 +112,12 @@ TEST_F(BenchCli, SphTableQuick) {
   // 2 sizes x 2 neighbour counts x 2 thread counts.
   expect_csv(d / "sph-table.csv",
              {"particles", "neighbours", "measured_neighbours", "strategy", "threads", "steps", "hz",
-              "us_per_particle_step", "share_hash", "share_search_density", "share_forces", "share_integrate",
+              "us_per_particle_step", "share_structure", "share_search_density", "share_forces", "share_integrate",
               "share_other", "speedup", "efficiency", "thesis_ppc970_hz", "thesis_cell_1spe_hz", "thesis_cell_8spe_hz",
-              "thesis_cell_8spe_efficiency", "sorts_per_step", "kf_sort", "kf_density", "kf_forces", "kf_integrate",
-              "kf_step"},
+              "thesis_cell_8spe_efficiency", "sorts_per_step", "kf_structure", "kf_density", "kf_forces", "kf_integrate",
+              "kf_step", "kf_noise"},
              8,
-             {"particles", "measured_neighbours", "threads", "hz", "us_per_particle_step", "share_hash",
+             {"particles", "measured_neighbours", "threads", "hz", "us_per_particle_step", "share_structure",
               "share_search_density", "share_forces", "share_integrate", "share_other", "speedup", "efficiency"});
   expect_csv(d / "sph-table_settle.csv",
              {"particles", "neighbours", "target", "initial_neighbours", "settled_neighbours", "settle_steps",
@@ -128,6 +128,7 @@ TEST_F(BenchCli, SphTableQuick) {
   for (const auto& row : csv.rows) {
     EXPECT_EQ(row[0] == "1000", !row[15].empty()) << row[0];
     EXPECT_EQ(row[4] != "1", !row[24].empty()) << row[0];  // Karp-Flatt e of the whole step: p > 1 rows only
+    EXPECT_EQ(row[3], "grid (scene default)") << "every row names its strategy";
   }
   expect_records(d / "sph-table.json", "sph-table");
   EXPECT_TRUE(fs::exists(d / "sph-table.md"));
