@@ -114,7 +114,7 @@ void BM_Search(benchmark::State& state) {
     } else {
       hash.build(p, Real(s.smoothing_length), sph::default_bucket_count(n), kBlock);
       Real* rho = p.density.data();
-      hash.find_neighbours(p, true, kBlock, lists, [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t c) {
+      hash.find_neighbours(p, spatial::DuplicateCheck::BeforeDistance, kBlock, lists, [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t c) {
         Real sum = 0;
         for (std::size_t k = 0; k < c; ++k) sum += p.mass[nb[k]] * w(r2[k]);
         rho[i] = sum;

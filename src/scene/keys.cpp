@@ -37,6 +37,9 @@ constexpr std::span<const EnumName<sph::NeighbourSearch>> names_of(sph::Neighbou
   return sph::kNeighbourSearchNames;
 }
 constexpr std::span<const EnumName<spatial::CellOrder>> names_of(spatial::CellOrder) { return spatial::kCellOrderNames; }
+constexpr std::span<const EnumName<spatial::DuplicateCheck>> names_of(spatial::DuplicateCheck) {
+  return spatial::kCheckPlacementNames;
+}
 constexpr std::span<const EnumName<spatial::CellTable>> names_of(spatial::CellTable) { return spatial::kCellTableNames; }
 constexpr std::span<const EnumName<gravity::Method>> names_of(gravity::Method) { return gravity::kMethodNames; }
 constexpr std::span<const EnumName<gravity::Scheme>> names_of(gravity::Scheme) { return gravity::kSchemeNames; }
@@ -354,6 +357,12 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "sph.hash.duplicate_check", .section = "sph",
                      .doc = "the thesis's cell-relation check against duplicate interactions"},
             in_sph(&sph::SphParameters::duplicate_check)));
+  add(field(SceneKey{.key = "sph.hash.check_placement", .section = "sph",
+                     .doc = "where the duplicate check runs: `\"before_distance\"` (ours: a colliding entry costs no "
+                            "distance test) or `\"after_distance\"` (the thesis's place, section 4.2.3: the cells of "
+                            "the pairs within h); the same pairs in the same order either way",
+                     .hashed = false},
+            in_sph(&sph::SphParameters::check_placement)));
 
   // [random_box] with the root key `particles`.
   add(field(SceneKey{.key = "particles", .section = "random_box", .unit = "particles", .range = kParticleCount,

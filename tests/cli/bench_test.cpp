@@ -142,9 +142,9 @@ TEST_F(BenchCli, HashStatsQuick) {
   const auto d = dir_ / "hash-stats";
   expect_csv(d / "hash-stats.csv", {"statistic", "swirl", "thesis"}, 8, {"swirl", "thesis"});
   expect_csv(d / "hash-stats_check.csv",
-             {"threads", "steps", "hz_check_on", "hz_check_off", "gain_check_off_pct", "thesis_ppc970_gain_pct",
-              "thesis_cell_gain_pct"},
-             2, {"hz_check_on", "hz_check_off", "thesis_cell_gain_pct"});
+             {"threads", "steps", "hz_check_on", "hz_check_after", "hz_check_off", "gain_check_off_pct",
+              "gain_check_off_thesis_place_pct", "thesis_ppc970_gain_pct", "thesis_cell_gain_pct"},
+             2, {"hz_check_on", "hz_check_after", "hz_check_off", "thesis_cell_gain_pct"});
   expect_records(d / "hash-stats.json", "hash-stats");
   EXPECT_NE(r.out.find("24001"), std::string::npos) << "the thesis's table size beside ours";
 }

@@ -64,8 +64,8 @@ HashStatistics hash_statistics(const ParticleSet<Real>& p, Real h, std::uint32_t
   NeighbourList<Real> lists;
   auto ignore = [](std::uint32_t, const std::uint32_t*, const Real*, std::size_t) {};
   SearchCounters checked, unchecked;
-  hash.find_neighbours(p, true, block_size, lists, ignore, &checked);
-  hash.find_neighbours(p, false, block_size, lists, ignore, &unchecked);
+  hash.find_neighbours(p, DuplicateCheck::BeforeDistance, block_size, lists, ignore, &checked);
+  hash.find_neighbours(p, DuplicateCheck::Off, block_size, lists, ignore, &unchecked);
   s.tests = checked.tests;
   s.redundant_tests = checked.redundant_tests;
   s.interactions = checked.interactions;

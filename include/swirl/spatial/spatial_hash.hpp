@@ -9,11 +9,15 @@
 // find_neighbours(): for every particle, in bucket order (the thesis walks the
 // table bucket by bucket, Algorithm 4), all 27 cells around its cell are
 // hashed and their buckets scanned. A particle found in a scanned bucket whose
-// cell is not the searched one is there by a hash collision: with the
-// duplicate check on (the default) it is skipped, which also drops the
-// duplicate interactions that arise when two of the 27 cells share a bucket;
-// with it off (the thesis's faster option) such pairs are distance-tested and
-// duplicates can appear. Interaction lists are CSR (NeighbourList), one row per
+// cell is not the searched one is there by a hash collision, and the duplicate
+// check (DuplicateCheck) drops it, which also drops the duplicate interactions
+// that arise when two of the 27 cells share a bucket. Where the check runs is
+// a choice: BeforeDistance (ours, the default) compares the cells first and
+// skips the distance test of a collision; AfterDistance (the thesis's place,
+// section 4.2.3: "in addition to checking distances ... their grid cell
+// relation must be tested") tests the distance first and the cells of the
+// pairs within h. Both give the same pairs. Off (the thesis's faster option)
+// keeps every pair within h, so duplicates can appear. Interaction lists are CSR (NeighbourList), one row per
 // particle in bucket order, neighbours in scan order: deterministic for any
 // thread count.
 //
@@ -32,10 +36,12 @@
 #include "swirl/parallel/counting_sort.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/distance.hpp"
+#include "swirl/spatial/duplicate_check.hpp"
 #include "swirl/spatial/neighbour_list.hpp"
 #include "swirl/spatial/teschner_hash.hpp"
 
 namespace swirl::spatial {
+
 
 // What a search saw, for the thesis's Table 5.2.
 struct SearchCounters {
@@ -89,7 +95,7 @@ class SpatialHash {
   // 4). on_row runs in parallel and may only write particle i's data. If
   // `counters` is given, it receives the totals of the search.
   template <class OnRow>
-  void find_neighbours(const ParticleSet<Real>& p, bool duplicate_check, std::size_t block_size,
+  void find_neighbours(const ParticleSet<Real>& p, DuplicateCheck check, std::size_t block_size,
                       NeighbourList<Real>& out, OnRow&& on_row, SearchCounters* counters = nullptr) {
     const std::size_t n = p.size();
     if (cells_.size() != n) throw std::logic_error("spatial hash: find_neighbours() on particles it was not built for");
@@ -119,15 +125,15 @@ class SpatialHash {
               const std::uint32_t b = hash_cell(c, buckets);
               for (std::uint32_t s = offsets[b]; s < offsets[b + 1]; ++s) {
                 if (s == row) continue;  // the particle itself
-                const bool same_cell = sorted_cells_[s] == c;
                 if (counters) {
                   ++local.tests;
-                  local.redundant_tests += same_cell ? 0 : 1;
+                  local.redundant_tests += sorted_cells_[s] == c ? 0 : 1;
                 }
-                if (duplicate_check && !same_cell) continue;
+                if (check == DuplicateCheck::BeforeDistance && !(sorted_cells_[s] == c)) continue;
                 const Real r2 = distance2(xi, yi, zi, sorted_position_[0][s], sorted_position_[1][s],
                                           sorted_position_[2][s]);
                 if (within(r2, h2)) {
+                  if (check == DuplicateCheck::AfterDistance && !(sorted_cells_[s] == c)) continue;
                   list.neighbour.push_back(order[s]);
                   list.r2.push_back(r2);
                 }

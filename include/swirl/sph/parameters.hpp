@@ -8,6 +8,7 @@
 
 #include "swirl/core/enum_names.hpp"
 #include "swirl/spatial/cell_order.hpp"
+#include "swirl/spatial/duplicate_check.hpp"
 
 namespace swirl::sph {
 
@@ -45,6 +46,7 @@ struct SphParameters {
   double viscosity = 0.1;          // μ, Pa·s (≥ 0)
   std::uint32_t buckets = 0;       // hash: table size M; 0 = the thesis's ≈ 1.6·N (made odd)
   bool duplicate_check = true;     // hash: the cell-relation check of section 4.2.3
+  spatial::DuplicateCheck check_placement = spatial::DuplicateCheck::BeforeDistance;  // hash: where it runs
   PressureForm pressure_form = PressureForm::Thesis;
   NegativePressure negative_pressure = NegativePressure::Keep;
   NeighbourSearch neighbour_search = NeighbourSearch::Grid;

@@ -254,7 +254,8 @@ class SphFluid final : public Solver<Real> {
       const Real* m = p.mass.data();
       Real* rho = p.density.data();
       Real* pressure = p.pressure.data();
-      hash_.find_neighbours(p, params_.duplicate_check, ctx.block_size, lists_,
+      hash_.find_neighbours(p, params_.duplicate_check ? params_.check_placement : spatial::DuplicateCheck::Off,
+                            ctx.block_size, lists_,
                            [&](std::uint32_t i, const std::uint32_t* nb, const Real* r2, std::size_t count) {
                              // The particle itself (r = 0), then its neighbours (all r < h).
                              Real sum = laws.density.term(m[i], laws.gap2(Real(0)));
