@@ -23,7 +23,6 @@ double seconds_since(Clock::time_point t0) { return std::chrono::duration<double
 // Particles per block of a global walk: walks differ in cost, so small blocks balance better.
 constexpr std::size_t kWalkBlock = 64;
 // Memory for per-tree contributions held at once (each is N × 4 reals).
-constexpr std::size_t kBufferBytes = std::size_t(64) << 20;
 
 constexpr int kMortonLevels = 21;  // 3 × 21 = 63 key bits
 
@@ -362,10 +361,14 @@ void BarnesHut<Real>::walk_sources(const ParticleSet<Real>& p, GravityField<Real
                                    const std::vector<std::uint64_t>& weights) {
   const std::size_t n = p.size(), sources = sources_.size();
   const std::size_t bins = std::size_t(parallel::thread_count());
-  // Contributions of `chunk` trees are held at once: at least one per thread,
-  // a few per thread for a better deal, within the memory budget.
-  const std::size_t affordable = kBufferBytes / std::max<std::size_t>(1, 4 * n * sizeof(Real));
-  const std::size_t chunk = std::max<std::size_t>(1, std::min(sources, std::max(bins, std::min(8 * bins, affordable))));
+  // The paper balances all trees at once (heaviest first to the least loaded
+  // SPE). Here each tree's contribution is a field of n particles, summed into
+  // the result in tree order so that the sum is the same for any thread count;
+  // the deal covers as many trees as the buffer budget holds at once (all of
+  // them when it holds them, e.g. 51 trees of 8192 particles), and at least
+  // one per thread.
+  const std::size_t affordable = buffer_bytes_ / std::max<std::size_t>(1, 4 * n * sizeof(Real));
+  const std::size_t chunk = std::max<std::size_t>(1, std::min(sources, std::max(bins, affordable)));
   buffers_.resize(chunk);
   for (auto& b : buffers_) b.resize(n);
   for (int a = 0; a < 3; ++a) std::fill(out.acceleration[a].begin(), out.acceleration[a].end(), Real(0));

@@ -161,6 +161,31 @@ TYPED_TEST(SchemesTest, NoParticleOrOneParticleFeelsNothing) {
   }
 }
 
+// The trees are walked and dealt in batches that the buffer budget holds; a
+// budget of one tree per thread (many batches) gives the bits of one batch.
+TYPED_TEST(SchemesTest, TreesInManySmallBatchesGiveTheSameBitsAsOneBatch) {
+  using Real = TypeParam;
+  const int saved = parallel::thread_count();
+  parallel::set_thread_count(2);
+  const auto p = plummer<Real>(3000, 5);
+  for (Scheme scheme : {Scheme::Subdomain, Scheme::Subtree}) {
+    SCOPED_TRACE(to_string(scheme));
+    BarnesHut<Real> whole(settings(scheme, 0.5, 0.01, true)), batched(settings(scheme, 0.5, 0.01, true));
+    batched.set_tree_buffer_bytes(1);  // one tree per thread per batch
+    GravityField<Real> a, b;
+    for (int evaluation = 0; evaluation < 2; ++evaluation) {  // the second deals by measured work
+      whole.compute(p, a, 256);
+      batched.compute(p, b, 256);
+      ASSERT_GT(whole.work().size(), 4u) << "several batches need several trees";
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        ASSERT_EQ(a.acceleration.get(i), b.acceleration.get(i)) << i;
+        ASSERT_EQ(a.potential[i], b.potential[i]) << i;
+      }
+    }
+  }
+  parallel::set_thread_count(saved);
+}
+
 template <class Real>
 ParticleSet<Real> run_steps(Scheme scheme, bool small, int threads) {
   parallel::set_thread_count(threads);

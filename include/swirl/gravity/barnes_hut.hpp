@@ -88,6 +88,12 @@ class BarnesHut {
   // evaluation: the load metric of section 4.1.1.
   std::span<const std::uint64_t> work() const { return work_; }
 
+  // Memory for the per-tree fields of the subdomain and subtree schemes
+  // (N × 4 reals per tree in flight; default 64 MiB): the trees are walked
+  // and balanced in batches of as many as it holds, at least one per thread.
+  // Results do not depend on it.
+  void set_tree_buffer_bytes(std::size_t bytes) { buffer_bytes_ = bytes; }
+
  private:
   // A tree to walk, and the nodes its walk starts from.
   struct Source {
@@ -117,6 +123,7 @@ class BarnesHut {
   std::vector<std::uint32_t> home_tree_, home_leaf_;  // the tree and leaf holding each particle
   std::vector<std::uint64_t> work_, previous_work_;
   std::vector<GravityField<Real>> buffers_;  // one tree's contribution per buffer
+  std::size_t buffer_bytes_ = std::size_t(64) << 20;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keys_;
   std::vector<std::uint32_t> identity_;
   LinearOctree<Real> linear_;
