@@ -325,6 +325,12 @@ std::vector<SceneKey> declare_scene_keys() {
             in_sph(&sph::SphParameters::sound_speed)));
   add(field(SceneKey{.key = "sph.viscosity", .section = "sph", .unit = "Pa·s", .range = kNonNegative, .doc = "μ"},
             in_sph(&sph::SphParameters::viscosity)));
+  add(field(SceneKey{.key = "sph.gradient_correction", .section = "sph",
+                     .doc = "corrects the pressure force by M_i⁻¹ (Bonet & Lok's kernel-gradient renormalisation: exact "
+                            "for a linear pressure field; not momentum-conserving; off where det M_i < 0.5, as at a "
+                            "free surface); docs/sph.md",
+                     .unhashed_value = "false"},
+            in_sph(&sph::SphParameters::gradient_correction)));
   add(field(SceneKey{.key = "sph.pressure", .section = "sph", .noun = "pressure form",
                      .doc = "`\"thesis\"` (eq. 2.8, applies ½∇p) or `\"consistent\"` (see docs/sph.md)"},
             in_sph(&sph::SphParameters::pressure_form)));

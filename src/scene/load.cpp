@@ -615,8 +615,11 @@ std::string read_file(const std::filesystem::path& file, const std::string& /*na
 std::string canonical_text(const Scene& s) {
   std::string out;
   for (const auto& spec : scene_keys())
-    if (const auto value = spec.hashed ? spec.get(s) : std::nullopt)
-      out += fmt::format("{} = {}\n", spec.key, value_text(*value, true));
+    if (const auto value = spec.hashed ? spec.get(s) : std::nullopt) {
+      const std::string text = value_text(*value, true);
+      if (!spec.unhashed_value.empty() && text == spec.unhashed_value) continue;
+      out += fmt::format("{} = {}\n", spec.key, text);
+    }
   for (const auto& source : s.sources) {
     const SourceKind& kind = kind_of(source);
     out += fmt::format("[[particles]]\nkind = \"{}\"\n", kind.name);

@@ -172,6 +172,11 @@ void forces_cell(const ForceKernelArgs<Real>& a, std::size_t first, std::size_t 
     qx += xsimd::hadd(svx);
     qy += xsimd::hadd(svy);
     qz += xsimd::hadd(svz);
+    if (laws.corrected) {
+      Real L[6];
+      for (int k = 0; k < 6; ++k) L[k] = a.correction[k][i];
+      GradientCorrection<Real>::apply(L, px, py, pz);
+    }
     const Real inv_rho = Real(1) / a.density[i];
     a.ax[i] += laws.acceleration(px, qx, inv_rho);
     a.ay[i] += laws.acceleration(py, qy, inv_rho);

@@ -118,6 +118,61 @@ TYPED_TEST(LawTest, AccelerationDividesTheNormalisedSumsByDensity) {
               8 * rel_tol<Real>() * std::abs(expected));
 }
 
+// The gradient correction: M_i from a full cubic lattice is c·I with c the
+// spiky gradient's lattice deficit (0.947 at h = 1.93 spacings, sph/laws.hpp),
+// L_i = M_i⁻¹ undoes it, a general symmetric M is inverted (L·M = I), and a
+// nearly singular M (a free surface's half kernel) gets no correction.
+TYPED_TEST(LawTest, GradientCorrectionInvertsTheLatticeMoment) {
+  using Real = TypeParam;
+  const double s = 0.01, h = 1.93 * s, V = s * s * s;
+  const SphLaws<Real> laws(parameters(h));
+  EXPECT_NEAR(double(laws.correction.norm), 45 / (kPi * std::pow(h, 6)), 1e-6 * 45 / (kPi * std::pow(h, 6)));
+  Real m6[6] = {}, half[6] = {};
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j)
+      for (int k = -2; k <= 2; ++k) {
+        const double dx = i * s, dy = j * s, dz = k * s, r = std::sqrt(dx * dx + dy * dy + dz * dz);
+        if (r == 0 || r >= h) continue;
+        const Real t = laws.correction.term(Real(V), laws.gap(Real(r)), Real(1 / r));
+        add_correction_term(t, Real(dx), Real(dy), Real(dz), m6);
+        if (k > 0 || (k == 0 && (j > 0 || (j == 0 && i > 0)))) add_correction_term(t, Real(dx), Real(dy), Real(dz), half);
+      }
+  const double c = double(laws.correction.norm) * double(m6[0]);
+  EXPECT_NEAR(c, 0.9467, 5e-4);
+  EXPECT_NEAR(double(laws.correction.norm) * double(m6[3]), c, 1e-5);
+  EXPECT_NEAR(double(laws.correction.norm) * double(m6[1]), 0.0, 1e-6);
+  Real L[6];
+  laws.correction.inverse(m6, L);
+  EXPECT_NEAR(double(L[0]), 1 / c, 1e-5);
+  EXPECT_NEAR(double(L[5]), 1 / c, 1e-5);
+  EXPECT_NEAR(double(L[2]), 0.0, 1e-5);
+  Real px = Real(2), py = Real(-1), pz = Real(0.5);
+  GradientCorrection<Real>::apply(L, px, py, pz);
+  EXPECT_NEAR(double(px), 2 / c, 1e-5);
+  EXPECT_NEAR(double(py), -1 / c, 1e-5);
+
+  // A general symmetric positive matrix (as sums, before norm).
+  const double a[6] = {1.2, 0.1, -0.2, 0.9, 0.15, 1.1};
+  Real sums[6];
+  for (int q = 0; q < 6; ++q) sums[q] = Real(a[q] / double(laws.correction.norm));
+  laws.correction.inverse(sums, L);
+  const double M[3][3] = {{a[0], a[1], a[2]}, {a[1], a[3], a[4]}, {a[2], a[4], a[5]}};
+  const double Li[3][3] = {{L[0], L[1], L[2]}, {L[1], L[3], L[4]}, {L[2], L[4], L[5]}};
+  for (int r = 0; r < 3; ++r)
+    for (int col = 0; col < 3; ++col) {
+      double e = 0;
+      for (int q = 0; q < 3; ++q) e += Li[r][q] * M[q][col];
+      EXPECT_NEAR(e, r == col ? 1.0 : 0.0, 1e-5) << r << ", " << col;
+    }
+
+  // Half a lattice (a free surface): det M ≈ 1/8 < 0.5, so L = I.
+  laws.correction.inverse(half, L);
+  EXPECT_EQ(L[0], Real(1));
+  EXPECT_EQ(L[3], Real(1));
+  EXPECT_EQ(L[5], Real(1));
+  EXPECT_EQ(L[1], Real(0));
+}
+
 // The SIMD loop instantiates the same evaluators with batches: lane by lane
 // they equal the scalar ones to rounding (FMA contraction may differ).
 TYPED_TEST(LawTest, BatchesEvaluateTheSameLaws) {

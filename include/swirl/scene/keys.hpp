@@ -75,6 +75,10 @@ struct KeySpec {
   // for the unknown-key check, validation, the hash and the docs.
   bool custom_read = false;
   bool hashed = true;        // false only for keys that cannot change a run's results
+  // A key added after checkpoints existed: its value is left out of the hash
+  // when it is this one (the behaviour from before the key), so that those
+  // checkpoints keep their hash while any other value changes it.
+  std::string_view unhashed_value{};
   // The typed field's value; nullopt when the owner has none (its section or
   // optional field is absent, or the key names no field of its own).
   std::function<std::optional<KeyValue>(const Owner&)> get{};

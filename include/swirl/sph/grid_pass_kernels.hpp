@@ -41,6 +41,7 @@ struct ForceKernelArgs {
   const Real *vx = nullptr, *vy = nullptr, *vz = nullptr;
   const Real *volume = nullptr, *pressure_volume = nullptr, *pressure = nullptr, *density = nullptr;
   Real *ax = nullptr, *ay = nullptr, *az = nullptr;  // accumulated into (+=)
+  const Real* correction[6] = {};  // L_i (xx, xy, xz, yy, yz, zz) when laws.corrected
   std::size_t n = 0;
   SphLaws<Real> laws;  // pressure and viscosity laws
 };

@@ -50,10 +50,17 @@ namespace swirl::sph {
 
 // Per-particle values the density pass leaves for the force pass (sorted
 // order): V_i = m_i / ρ_i and p_i V_i, so that a pair costs no division but 1/r.
+// With the gradient correction on, grid_gradient_correction() leaves L_i
+// (xx, xy, xz, yy, yz, zz; sph/laws.hpp) for the force pass.
 template <class Real>
 struct GridScratch {
   AlignedVector<Real> volume, pressure_volume;
-  std::size_t bytes() const { return (volume.capacity() + pressure_volume.capacity()) * sizeof(Real); }
+  std::array<AlignedVector<Real>, 6> correction;
+  std::size_t bytes() const {
+    std::size_t reals = volume.capacity() + pressure_volume.capacity();
+    for (const auto& c : correction) reals += c.capacity();
+    return reals * sizeof(Real);
+  }
 };
 
 namespace detail {
@@ -145,8 +152,37 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
   }
 }
 
+// The gradient correction L_i = M_i⁻¹ of every particle (laws.correction,
+// sph/laws.hpp) into scratch.correction, from the volumes grid_density() left.
+// One scalar pass over the same pairs; run only when laws.corrected.
+template <class Real>
+void grid_gradient_correction(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& p,
+                              const SphLaws<Real>& laws, std::size_t block_size, GridScratch<Real>& scratch) {
+  const std::size_t n = p.size();
+  for (auto& c : scratch.correction) c.resize(n);
+  const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
+  const Real* V = scratch.volume.data();
+  parallel::for_blocks_pinned("sph_grid_correction", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    const SphLaws<Real> law = laws;
+    detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+      Real m6[6] = {};
+      for (int r = 0; r < count; ++r)
+        for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j) {
+          const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+          const Real r2 = dx * dx + dy * dy + dz * dz;
+          if (!spatial::within(r2, law.h2)) continue;
+          const Real rr = std::sqrt(r2), inv_r = rr > Real(0) ? Real(1) / rr : Real(0);
+          add_correction_term(law.correction.term(V[j], law.gap(rr), inv_r), dx, dy, dz, m6);
+        }
+      Real L[6];
+      law.correction.inverse(m6, L);
+      for (int k = 0; k < 6; ++k) scratch.correction[static_cast<std::size_t>(k)][i] = L[k];
+    });
+  });
+}
+
 // Adds the pressure and viscosity accelerations (densities, pressures and the
-// scratch from grid_density()): per pair PressureLaw::term · r⃗ and
+// scratch from grid_density(); with laws.corrected also grid_gradient_correction()'s): per pair PressureLaw::term · r⃗ and
 // ViscosityLaw::term · (v_j − v_i) summed, SphLaws::acceleration() once per
 // particle.
 template <class Real>
@@ -165,6 +201,8 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     a.volume = V, a.pressure_volume = PV, a.pressure = pr, a.density = rho;
     a.ax = ax, a.ay = ay, a.az = az, a.n = n;
     a.laws = laws;
+    if (laws.corrected)
+      for (int k = 0; k < 6; ++k) a.correction[k] = scratch.correction[static_cast<std::size_t>(k)].data();
     parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
         forces_cell_simd(a, first, last, ranges.data(), count);
@@ -198,6 +236,11 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
       for (int r = 0; r < count; ++r)
         for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j)
           pair(i, j, s);
+      if (law.corrected) {
+        Real L[6];
+        for (int k = 0; k < 6; ++k) L[k] = scratch.correction[static_cast<std::size_t>(k)][i];
+        GradientCorrection<Real>::apply(L, s.px, s.py, s.pz);
+      }
       const Real inv_rho = Real(1) / rho[i];
       ax[i] += law.acceleration(s.px, s.vx, inv_rho);
       ay[i] += law.acceleration(s.py, s.vy, inv_rho);

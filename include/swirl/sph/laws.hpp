@@ -4,6 +4,8 @@
 //   DensityLaw       ρ_i = Σ_j m_j W_poly6(r_ij)                     (eq. 2.3, 2.11)
 //   PressureLaw      f_i = −Σ_j m_j (p_i + p_j) / (2 ρ_j) ∇W_spiky    (eq. 2.8)
 //   ViscosityLaw     f_i = μ Σ_j m_j (v_j − v_i) / ρ_j ∇²W_visc       (eq. 2.10)
+//   GradientCorrection  L_i = (Σ_j V_j ∇W_ij ⊗ (x_i − x_j))⁻¹, applied to the
+//                    pressure force when sph.gradient_correction is on
 //
 // and SphLaws, the one set of them built from SphParameters that every driver
 // takes: the scalar grid loop and the SIMD grid loop with its scalar tail
@@ -127,6 +129,73 @@ struct ViscosityLaw {
   }
 };
 
+// Kernel-gradient correction (Bonet & Lok 1999, "renormalisation"), for the
+// pressure force only:
+//   M_i = Σ_j V_j ∇W_spiky(r_ij) ⊗ (x_j − x_i)
+//       = norm · Σ_j V_j (h − r)² / r · r⃗_ij ⊗ r⃗_ij,   r⃗_ij = x_i − x_j,  norm = 45 / (π h⁶)
+// is the identity in the continuum; on particles it is not (on a cubic lattice
+// at h = 1.93 spacings it is 0.947·I), so a pressure gradient is felt too
+// weakly and a fluid at rest under gravity settles to a pressure too high by
+// that factor. The corrected force is L_i f_i with L_i = M_i⁻¹: exact for a
+// linear pressure field, but no longer antisymmetric (momentum is not
+// conserved to rounding). Where M_i is nearly singular (a free surface: the
+// half kernel's M has a determinant near 1/8) the correction would amplify
+// the surface's one-sided sum, so L_i = I where det M_i < kMinDeterminant.
+// term() is one j's V_j (h − r)²/r, the factor of r⃗_ij ⊗ r⃗_ij (from the same
+// q = h − r and 1/r as the pressure term; 0 at r = 0); the six sums are
+// xx, xy, xz, yy, yz, zz.
+template <class Real>
+struct GradientCorrection {
+  static constexpr Real kMinDeterminant = Real(0.5);
+  Real norm = 0;  // 1/m⁶
+
+  template <class V>
+  SWIRL_LAW_INLINE V term(const V& vol_j, const V& q, const V& inv_r) const {
+    return vol_j * (q * q * inv_r);
+  }
+
+  // L = (norm · sums)⁻¹ as xx, xy, xz, yy, yz, zz; the identity where the
+  // matrix is too close to singular (see above) or not finite.
+  void inverse(const Real (&sums)[6], Real (&out)[6]) const {
+    const Real a = norm * sums[0], b = norm * sums[1], c = norm * sums[2];
+    const Real d = norm * sums[3], e = norm * sums[4], f = norm * sums[5];
+    // Cofactors of the symmetric matrix [[a b c] [b d e] [c e f]].
+    const Real A = d * f - e * e, B = c * e - b * f, C = b * e - c * d;
+    const Real det = a * A + b * B + c * C;
+    if (!(det >= kMinDeterminant) || !(det < std::numeric_limits<Real>::infinity())) {
+      out[0] = out[3] = out[5] = Real(1);
+      out[1] = out[2] = out[4] = Real(0);
+      return;
+    }
+    const Real inv = Real(1) / det;
+    out[0] = A * inv;
+    out[1] = B * inv;
+    out[2] = C * inv;
+    out[3] = (a * f - c * c) * inv;
+    out[4] = (b * c - a * e) * inv;
+    out[5] = (a * d - b * b) * inv;
+  }
+
+  // (px, py, pz) ← L (px, py, pz), L as inverse() gives it.
+  SWIRL_LAW_INLINE static void apply(const Real (&L)[6], Real& px, Real& py, Real& pz) {
+    const Real x = px, y = py, z = pz;
+    px = L[0] * x + L[1] * y + L[2] * z;
+    py = L[1] * x + L[3] * y + L[4] * z;
+    pz = L[2] * x + L[4] * y + L[5] * z;
+  }
+};
+
+// Adds one pair's t · r⃗ ⊗ r⃗ to the six sums of GradientCorrection.
+template <class Real>
+SWIRL_LAW_INLINE void add_correction_term(Real t, Real dx, Real dy, Real dz, Real (&sums)[6]) {
+  sums[0] += t * dx * dx;
+  sums[1] += t * dx * dy;
+  sums[2] += t * dx * dz;
+  sums[3] += t * dy * dy;
+  sums[4] += t * dy * dz;
+  sums[5] += t * dz * dz;
+}
+
 // The laws of one fluid, built once from its parameters (in Real: the
 // constants every driver uses are these, rounded once).
 template <class Real>
@@ -138,13 +207,17 @@ struct SphLaws {
   DensityLaw<Real> density;
   PressureLaw<Real> pressure;
   ViscosityLaw<Real> viscosity;
+  GradientCorrection<Real> correction;
+  bool corrected = false;  // sph.gradient_correction: L_i applied to the pressure sums
 
   SphLaws() = default;
   explicit SphLaws(const SphParameters& params)
       : SphLaws(Real(params.smoothing_length),
                 {Real(params.rest_density), Real(params.sound_speed * params.sound_speed),
                  params.negative_pressure == NegativePressure::Zero ? Real(0) : -std::numeric_limits<Real>::infinity()},
-                Real(params.viscosity), params.pressure_form) {}
+                Real(params.viscosity), params.pressure_form) {
+    corrected = params.gradient_correction;
+  }
   // From the constants in Real: h (m), the equation of state, μ (Pa·s) and the form of eq. 2.8.
   SphLaws(Real h_, const EquationOfState<Real>& eos_, Real mu, PressureForm form) : h(h_), h2(h_ * h_), eos(eos_) {
     density.norm = Poly6<Real>(h).norm;
@@ -153,6 +226,7 @@ struct SphLaws {
     const Real half = form == PressureForm::Thesis ? Real(0.5) : Real(1);
     pressure.norm = -Spiky<Real>(h).grad_norm * half;
     viscosity.norm = mu * Viscosity<Real>(h).laplacian_norm;
+    correction.norm = -Spiky<Real>(h).grad_norm;
   }
 
   // d = h² − r², the factor of W_poly6 (the density law's argument; > 0 for

@@ -45,6 +45,7 @@ struct SphParameters {
   double sound_speed = 10;         // c, m/s
   double viscosity = 0.1;          // μ, Pa·s (≥ 0)
   std::uint32_t buckets = 0;       // hash: table size M; 0 = the thesis's ≈ 1.6·N (made odd)
+  bool gradient_correction = false;  // L_i = M_i⁻¹ on the pressure force (sph/laws.hpp, GradientCorrection)
   bool duplicate_check = true;     // hash: the cell-relation check of section 4.2.3
   spatial::DuplicateCheck check_placement = spatial::DuplicateCheck::BeforeDistance;  // hash: where it runs
   PressureForm pressure_form = PressureForm::Thesis;

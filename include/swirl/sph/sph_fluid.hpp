@@ -232,6 +232,10 @@ class SphFluid final : public Solver<Real> {
     }
     mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
     count_evaluation();
+    if (k.corrected) {
+      PhaseScope phase(ctx, "forces.correction");
+      grid_gradient_correction(grid_, p, k, ctx.block_size, scratch_);
+    }
     {
       PhaseScope phase(ctx, "forces.sph");
       grid_forces(grid_, p, k, ctx.block_size, scratch_, kernel_path());
@@ -293,6 +297,7 @@ class SphFluid final : public Solver<Real> {
       for (std::size_t row = first; row < last; ++row) {
         const std::uint32_t i = L.row_particle[row];
         Real px = 0, py = 0, pz = 0, qx = 0, qy = 0, qz = 0;  // pressure and viscosity sums
+        Real m6[6] = {};  // the gradient correction's sums (sph/laws.hpp), when it is on
         for (std::size_t k = L.offsets[row]; k < L.offsets[row + 1]; ++k) {
           const std::uint32_t j = L.neighbour[k];
           // 1/r = 0 at r = 0 (coincident particles): no pressure force without a direction.
@@ -300,12 +305,19 @@ class SphFluid final : public Solver<Real> {
           const Real vol_j = m[j] / rho[j];
           const Real fp = laws.pressure.term(pr[i], vol_j, pr[j] * vol_j, q, inv_r);  // along r⃗ = x_i − x_j
           const Real fv = laws.viscosity.term(vol_j, q);
-          px += fp * (x[i] - x[j]);
-          py += fp * (y[i] - y[j]);
-          pz += fp * (z[i] - z[j]);
+          const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
+          px += fp * dx;
+          py += fp * dy;
+          pz += fp * dz;
           qx += fv * (vx[j] - vx[i]);
           qy += fv * (vy[j] - vy[i]);
           qz += fv * (vz[j] - vz[i]);
+          if (laws.corrected) add_correction_term(laws.correction.term(vol_j, q, inv_r), dx, dy, dz, m6);
+        }
+        if (laws.corrected) {
+          Real correction[6];
+          laws.correction.inverse(m6, correction);
+          GradientCorrection<Real>::apply(correction, px, py, pz);
         }
         const Real inv_rho = Real(1) / rho[i];
         ax[i] += laws.acceleration(px, qx, inv_rho);
