@@ -30,7 +30,9 @@
 // reported together.
 //
 // A strategy is a sph.neighbour_search value, optionally followed by grid
-// settings joined with '+': "rows" or "morton" (sph.grid.cell_order),
+// settings joined with '+': "serial" or "parallel" (the hash's
+// sph.hash.table_build: "hash+serial" is the thesis's serial table build),
+// "rows" or "morton" (sph.grid.cell_order),
 // "dense" or "hashed" (sph.grid.table) and "skin=X" (sph.grid.skin in m) or
 // "skin=Xh" (X times the smoothing length), e.g.
 // --strategy grid+morton,grid+rows+skin=0.1h,grid+hashed.
@@ -142,6 +144,7 @@ struct Timing {
   double mean_k = 0;   // mean neighbours over the timed steps
   std::size_t warnings = 0;  // guard events
   double structure = 0, search = 0, forces = 0, integrate = 0;  // seconds per subtask
+  double table = 0;  // the hash's table build (counting sort), part of `structure`
 };
 
 // Times `steps` steps from the settled state with `threads` threads.
@@ -168,6 +171,7 @@ Timing time_steps(const scene::Scene& scene, const ParticleSet<float>& start, in
     if (name == "forces.search" || name == "forces.density") t.search += sec;
     else if (name == "forces.sph") t.forces += sec;
     else if (name == "integrate") t.integrate += sec;
+    else if (name == "forces.table") t.table += sec;  // timed inside forces.hash
     else if (name.rfind("forces.", 0) == 0) t.structure += sec;
   }
   return t;
@@ -208,6 +212,8 @@ std::vector<std::string> strategy_overrides(const std::string& strategy, double 
       first = false;
     } else if (part == "rows" || part == "morton") {
       out.push_back(fmt::format("sph.grid.cell_order=\"{}\"", part));
+    } else if (part == "serial" || part == "parallel") {
+      out.push_back(fmt::format("sph.hash.table_build=\"{}\"", part));
     } else if (part == "dense" || part == "hashed") {
       out.push_back(fmt::format("sph.grid.table=\"{}\"", part));
     } else if (part.rfind("skin=", 0) == 0) {
@@ -227,7 +233,7 @@ std::vector<std::string> strategy_overrides(const std::string& strategy, double 
     } else {
       throw std::invalid_argument(
           fmt::format("--strategy '{}': unknown setting '{}' (allowed after '+': rows, morton, dense, hashed, skin=X, "
-                      "skin=Xh)", strategy, part));
+                      "skin=Xh, serial, parallel)", strategy, part));
     }
   }
   return out;
@@ -265,6 +271,7 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
                {"hz", "Hz"},
                {"us_per_particle_step", "µs / particle / step"},
                {"share_structure", "structure build % (hash: hash + table; grid: sort + cells)"},
+               {"share_table", "of which the hash table's build %"},
                {"share_search_density", "search + density %"},
                {"share_forces", "forces %"},
                {"share_integrate", "integrate + collide %"},
@@ -330,7 +337,8 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
           t.add({integer(static_cast<long long>(n)), text(k_text(k)), number(m.mean_k, 1),
                  text(strategy_name(strategy, scene)), integer(p), integer(steps),
                  number(steps / m.seconds, 1), number(1e6 * m.seconds / (double(steps) * double(n)), 3),
-                 number(pct * m.structure, 1), number(pct * m.search, 1), number(pct * m.forces, 1),
+                 number(pct * m.structure, 1), m.table > 0 ? number(pct * m.table, 1) : none(),
+                 number(pct * m.search, 1), number(pct * m.forces, 1),
                  number(pct * m.integrate, 1), number(pct * other, 1), number(speedup, 2), number(speedup / p, 2),
                  seed && (k15 || k25) ? number(k15 ? seed->ppc970_k15_hz : seed->ppc970_k25_hz, 1) : none(),
                  seed && k25 ? number(seed->cell_1spe_hz, 1) : none(),
@@ -373,7 +381,9 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
       "instead), gravity off, c = 3 m/s, mu = 2 Pa s, restitution 0.5, fewer settling steps. Subtasks (Figure 5.2) "
       "come from the step's phase timers: structure build = `forces.hash` for the hash strategy (hashing and the "
       "counting-sort table build are one timer) and `forces.sort` + `forces.cells` for the grid (the shared order's "
-      "radix sort and the cell table), search + density = `forces.search` (grid: "
+      "radix sort and the cell table), of which the hash table's build = `forces.table` (the counting sort: the "
+      "thesis's serial portion, run on one thread with the strategy hash+serial, as its PPE did), search + "
+      "density = `forces.search` (grid: "
       "`forces.density`, which searches on the fly, as does its force pass), forces = `forces.sph`, integrate + collide = `integrate`, other "
       "= the rest of the wall time. The thesis's Figure 5.2 says the forces take less than {:.0f} % on the PPC "
       "970; its Figure 5.6 says hashing + search take {:.0f} % on one SPE. E(p) = S(p)/p with S(p) = t(1 "

@@ -40,6 +40,9 @@ constexpr std::span<const EnumName<spatial::CellOrder>> names_of(spatial::CellOr
 constexpr std::span<const EnumName<spatial::DuplicateCheck>> names_of(spatial::DuplicateCheck) {
   return spatial::kCheckPlacementNames;
 }
+constexpr std::span<const EnumName<spatial::TableBuild>> names_of(spatial::TableBuild) {
+  return spatial::kTableBuildNames;
+}
 constexpr std::span<const EnumName<spatial::CellTable>> names_of(spatial::CellTable) { return spatial::kCellTableNames; }
 constexpr std::span<const EnumName<gravity::Method>> names_of(gravity::Method) { return gravity::kMethodNames; }
 constexpr std::span<const EnumName<gravity::Scheme>> names_of(gravity::Scheme) { return gravity::kSchemeNames; }
@@ -369,6 +372,11 @@ std::vector<SceneKey> declare_scene_keys() {
                             "the pairs within h); the same pairs in the same order either way",
                      .hashed = false},
             in_sph(&sph::SphParameters::check_placement)));
+  add(field(SceneKey{.key = "sph.hash.table_build", .section = "sph",
+                     .doc = "hash: the table's counting sort on every thread (`\"parallel\"`) or on one "
+                            "(`\"serial\"`, as the thesis's PPE built it: its serial portion); the same table",
+                     .hashed = false},
+            in_sph(&sph::SphParameters::table_build)));
 
   // [random_box] with the root key `particles`.
   add(field(SceneKey{.key = "particles", .section = "random_box", .unit = "particles", .range = kParticleCount,

@@ -112,7 +112,7 @@ TEST_F(BenchCli, SphTableQuick) {
   // 2 sizes x 2 neighbour counts x 2 thread counts.
   expect_csv(d / "sph-table.csv",
              {"particles", "neighbours", "measured_neighbours", "strategy", "threads", "steps", "hz",
-              "us_per_particle_step", "share_structure", "share_search_density", "share_forces", "share_integrate",
+              "us_per_particle_step", "share_structure", "share_table", "share_search_density", "share_forces", "share_integrate",
               "share_other", "speedup", "efficiency", "thesis_ppc970_hz", "thesis_cell_1spe_hz", "thesis_cell_8spe_hz",
               "thesis_cell_8spe_efficiency", "sorts_per_step", "kf_structure", "kf_density", "kf_forces", "kf_integrate",
               "kf_step", "kf_noise"},
@@ -126,8 +126,8 @@ TEST_F(BenchCli, SphTableQuick) {
   // N = 1000 is a thesis row: its figures sit beside ours, 500 is not.
   const Csv csv = read_csv(d / "sph-table.csv");
   for (const auto& row : csv.rows) {
-    EXPECT_EQ(row[0] == "1000", !row[15].empty()) << row[0];
-    EXPECT_EQ(row[4] != "1", !row[24].empty()) << row[0];  // Karp-Flatt e of the whole step: p > 1 rows only
+    EXPECT_EQ(row[0] == "1000", !row[16].empty()) << row[0];
+    EXPECT_EQ(row[4] != "1", !row[25].empty()) << row[0];  // Karp-Flatt e of the whole step: p > 1 rows only
     EXPECT_EQ(row[3], "grid (scene default)") << "every row names its strategy";
   }
   expect_records(d / "sph-table.json", "sph-table");

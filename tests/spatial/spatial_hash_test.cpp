@@ -80,6 +80,21 @@ TYPED_TEST(SpatialHashTest, WithTheCheckOnTheListsAreExactlyTheBruteForcePairs) 
   }
 }
 
+// The thesis's serial table build (one thread, its PPE) gives the table of
+// the parallel build: the stable order is unique.
+TYPED_TEST(SpatialHashTest, TheSerialTableIsTheParallelTable) {
+  using Real = TypeParam;
+  const int saved = parallel::thread_count();
+  parallel::set_thread_count(3);
+  const auto p = random_particles<Real>(20000, -0.5, 1.5, 31);
+  SpatialHash<Real> parallel_table, serial_table;
+  parallel_table.build(p, Real(0.1), 16001u, 97);
+  serial_table.build(p, Real(0.1), 16001u, 97, TableBuild::Serial);
+  EXPECT_EQ(serial_table.order(), parallel_table.order());
+  EXPECT_EQ(serial_table.offsets(), parallel_table.offsets());
+  parallel::set_thread_count(saved);
+}
+
 // The thesis's place for the check (after the distance test) and ours (before
 // it) keep the same pairs, in the same order, on tables with many collisions.
 TYPED_TEST(SpatialHashTest, TheCheckAfterTheDistanceTestKeepsTheSamePairsAsBefore) {

@@ -26,7 +26,9 @@ class CountingSort {
   // checked by assert only: it is on the hot path). Afterwards
   // offsets()[k] .. offsets()[k+1] is the range of order() holding the indices
   // with key k, in increasing index order.
-  void sort(std::span<const std::uint32_t> keys, std::uint32_t key_count) {
+  // one_thread: the whole sort on the calling thread (the thesis's serial
+  // table build); the result is the same.
+  void sort(std::span<const std::uint32_t> keys, std::uint32_t key_count, bool one_thread = false) {
     const std::size_t n = keys.size();
     if (key_count == 0) throw std::invalid_argument("counting sort: key_count must be at least 1");
     if (n > 0xffffffffu) throw std::invalid_argument("counting sort: more than 2^32 - 1 items");
@@ -34,7 +36,8 @@ class CountingSort {
     // One chunk per thread (each costs key_count counters to clear and sum);
     // a descheduled thread's chunk is taken by another, and the count changes
     // the speed, never the result.
-    const std::size_t chunks = std::min<std::size_t>(n / 4096 + 1, static_cast<std::size_t>(thread_count()));
+    const std::size_t chunks =
+        one_thread ? 1 : std::min<std::size_t>(n / 4096 + 1, static_cast<std::size_t>(thread_count()));
     auto chunk_begin = [&](std::size_t c) { return n * c / chunks; };
     // Keys are cut into as many contiguous ranges for the prefix sum.
     auto key_begin = [&](std::size_t c) { return m * c / chunks; };

@@ -29,14 +29,16 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
 #include "swirl/core/particle_set.hpp"
+#include "swirl/core/phase_timers.hpp"
 #include "swirl/parallel/counting_sort.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/distance.hpp"
-#include "swirl/spatial/duplicate_check.hpp"
+#include "swirl/spatial/hash_options.hpp"
 #include "swirl/spatial/neighbour_list.hpp"
 #include "swirl/spatial/teschner_hash.hpp"
 
@@ -61,8 +63,10 @@ template <class Real>
 class SpatialHash {
  public:
   // Hashes the particles with cell length h (> 0) into `buckets` (≥ 1) buckets
-  // and builds the table.
-  void build(const ParticleSet<Real>& p, Real h, std::uint32_t buckets, std::size_t block_size) {
+  // and builds the table (its counting sort on one thread with TableBuild::Serial;
+  // the same table). With timers, the sort is the phase "forces.table".
+  void build(const ParticleSet<Real>& p, Real h, std::uint32_t buckets, std::size_t block_size,
+             TableBuild table = TableBuild::Parallel, PhaseTimers* timers = nullptr) {
     if (!(h > Real(0))) throw std::invalid_argument("spatial hash: cell length must be > 0");
     if (buckets == 0) throw std::invalid_argument("spatial hash: at least one bucket");
     h_ = h;
@@ -75,7 +79,11 @@ class SpatialHash {
         hashes_[i] = hash_cell(cells_[i], buckets);
       }
     });
-    sort_.sort(hashes_, buckets);
+    {
+      std::optional<ScopedPhase> phase;
+      if (timers) phase.emplace(*timers, "forces.table");
+      sort_.sort(hashes_, buckets, table == TableBuild::Serial);
+    }
     const auto& order = sort_.order();
     for (int axis = 0; axis < 3; ++axis) sorted_position_[axis].resize(n);
     sorted_cells_.resize(n);

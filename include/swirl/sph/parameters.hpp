@@ -8,7 +8,7 @@
 
 #include "swirl/core/enum_names.hpp"
 #include "swirl/spatial/cell_order.hpp"
-#include "swirl/spatial/duplicate_check.hpp"
+#include "swirl/spatial/hash_options.hpp"
 
 namespace swirl::sph {
 
@@ -48,6 +48,7 @@ struct SphParameters {
   bool gradient_correction = false;  // L_i = M_i⁻¹ on the pressure force (sph/laws.hpp, GradientCorrection)
   bool duplicate_check = true;     // hash: the cell-relation check of section 4.2.3
   spatial::DuplicateCheck check_placement = spatial::DuplicateCheck::BeforeDistance;  // hash: where it runs
+  spatial::TableBuild table_build = spatial::TableBuild::Parallel;  // hash: the table on every thread or one
   PressureForm pressure_form = PressureForm::Thesis;
   NegativePressure negative_pressure = NegativePressure::Keep;
   NeighbourSearch neighbour_search = NeighbourSearch::Grid;

@@ -250,7 +250,8 @@ class SphFluid final : public Solver<Real> {
     const Real h = Real(params_.smoothing_length);
     {
       PhaseScope phase(ctx, "forces.hash");
-      hash_.build(p, h, params_.buckets ? params_.buckets : default_bucket_count(n), ctx.block_size);
+      hash_.build(p, h, params_.buckets ? params_.buckets : default_bucket_count(n), ctx.block_size,
+                  params_.table_build, ctx.timers);
     }
     {
       PhaseScope phase(ctx, "forces.search");
