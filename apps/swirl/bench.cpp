@@ -1,6 +1,6 @@
 // `swirl bench SUITE`: the seeds' experiments, reproducible (bench.hpp).
 //
-//   swirl bench sph-table  [--sizes ...] [--neighbours 15,25] [--strategy hash,grid] [--settle 500] [--steps N]
+//   swirl bench sph-table  [--sizes ...] [--neighbours 15,25] [--strategy hash,grid] [--settle 3000] [--steps N]
 //   swirl bench hash-stats [--particles 15000] [--neighbours 25] [--buckets 24001] [--settle 500] [--steps N]
 //   swirl bench bh-table   [--sizes 1024,...,32768] [--schemes ...] [--iterations 50] [--opening 0.5]
 //   swirl bench bh-lambda  [--sizes 4096,32768] [--lambdas 0.3,0.5,0.7,0.9] [--schemes ...] [--iterations 20]

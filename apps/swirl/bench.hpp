@@ -56,6 +56,9 @@ struct Table {
   std::string title;
   std::vector<Column> columns;
   std::vector<std::vector<Cell>> rows;
+  // A long series (e.g. a curve over time): written to its CSV and plotted,
+  // named in the markdown but not printed there.
+  bool csv_only = false;
   // Appends a row; throws std::logic_error if its width is not the columns'.
   void add(std::vector<Cell> row);
   std::string markdown() const;
@@ -114,7 +117,7 @@ struct SphTableArgs {
   std::vector<std::size_t> sizes{1000, 2000, 5000, 10000, 15000, 20000, 25000, 30000, 35000};
   std::vector<double> neighbours{15, 25};  // measured neighbours aimed at
   std::vector<std::string> strategies;     // sph.neighbour_search values; empty: the scene default
-  int settle = 500;                        // steps before timing (the thesis: 3000)
+  int settle = 3000;                       // steps before timing: the thesis's 3000
   int steps = 0;                           // timed steps; 0: about 2·10⁶ particle-steps, 20..1000
 };
 struct HashStatsArgs {

@@ -304,6 +304,10 @@ int publish(const SuiteReport& r, const CommonArgs& args) {
   }
   for (const auto& t : r.tables) {
     if (!t.title.empty()) md += fmt::format("**{}**\n\n", t.title);
+    if (t.csv_only) {
+      md += fmt::format("{} rows in `{}` (plotted below).\n\n", t.rows.size(), table_file(r, t));
+      continue;
+    }
     md += t.markdown();
     md += "\n";
   }

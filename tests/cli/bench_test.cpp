@@ -133,7 +133,12 @@ TEST_F(BenchCli, SphTableQuick) {
   expect_records(d / "sph-table.json", "sph-table");
   EXPECT_TRUE(fs::exists(d / "sph-table.md"));
   // The plots need Debian's python3-matplotlib (make deps installs it).
-  for (const char* png : {"sph-table_cost.png", "sph-table_efficiency.png", "sph-table_subtasks.png"}) expect_png(d / png);
+  // Figure 5.1: the neighbour count along the settling, 6 points (steps 0..5) per size and k.
+  expect_csv(d / "sph-table_settling.csv", {"particles", "neighbours", "step", "mean_neighbours"}, 24,
+             {"step", "mean_neighbours"});
+  for (const char* png : {"sph-table_cost.png", "sph-table_efficiency.png", "sph-table_subtasks.png",
+                          "sph-table_settling.png"})
+    expect_png(d / png);
 }
 
 TEST_F(BenchCli, HashStatsQuick) {
