@@ -48,8 +48,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <fmt/format.h>
@@ -310,6 +312,9 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
   curve.csv_only = true;
   curve.columns = {{"particles", "N"}, {"neighbours", "k aimed"}, {"step", "step"}, {"mean_neighbours", "k"}};
 
+  // 1-thread rates by (N, k, strategy), for Figure 5.4's ratio.
+  std::vector<std::tuple<std::size_t, double, std::string, double>> one_thread_hz;
+
   for (std::size_t n : a.sizes) {
     for (double k : a.neighbours) {
       progress(fmt::format("sph-table: N = {}, k = {}: settling {} steps", n, k, a.settle));
@@ -336,6 +341,8 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
           if (p == 1) {
             one_thread = m.seconds;
             one = m;
+            one_thread_hz.emplace_back(n, k, strategy.empty() ? strategy_name(strategy, scene) : strategy,
+                                       steps / m.seconds);
           }
           const bool has_one = one.seconds > 0 && p > 1;
           std::string noise;
@@ -381,7 +388,29 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
                   {"precision", "float"},
                   {"strategies", a.strategies.empty() ? strategy_name("", random_box(1000, 25))
                                                       : fmt::format("{}", fmt::join(a.strategies, ","))}};
-  r.tables = {t, settled, curve};
+  // Figure 5.4: the thesis's one SPE over its PPC 970 (Table 5.3, k = 25),
+  // beside ours: one thread of the hash path (the thesis's algorithm) over one
+  // thread of the grid (ours), where both were run.
+  Table fig54;
+  fig54.name = "fig54";
+  fig54.title = "Figure 5.4: the thesis's 1 SPE over its PPC 970, and our hash over our grid (1 thread each)";
+  fig54.columns = {{"particles", "N"}, {"neighbours", "k aimed"}, {"hash_over_grid", "swirl: hash / grid, 1 thread"},
+                   {"thesis_spe_over_ppc", "thesis: 1 SPE / PPC 970 (Table 5.3, simulated / measured)"}};
+  auto rate = [&](std::size_t n, double k, const std::string& name) -> std::optional<double> {
+    for (const auto& [rn, rk, rs, hz] : one_thread_hz)
+      if (rn == n && rk == k && (rs == name || rs.rfind(name + " ", 0) == 0)) return hz;
+    return std::nullopt;
+  };
+  for (std::size_t n : a.sizes)
+    for (double k : a.neighbours) {
+      const auto hash = rate(n, k, "hash"), grid = rate(n, k, "grid");
+      const auto seed = seeds::thesis_sph_row(n);
+      if (!(hash && grid) && !(seed && k == 25)) continue;
+      fig54.add({integer(static_cast<long long>(n)), text(k_text(k)),
+                 hash && grid ? number(*hash / *grid, 3) : none(),
+                 seed && k == 25 ? number(seed->cell_1spe_hz / seed->ppc970_k25_hz, 2) : none()});
+    }
+  r.tables = {t, settled, curve, fig54};
   r.notes = fmt::format(
       "The thesis's PPC 970 figures are measured (one core of a 2.0 GHz G5); its Cell figures come from IBM's "
       "simulator, which did not model memory transfers. k aimed 15 and 25 stand for the thesis's \"about 15\" and "

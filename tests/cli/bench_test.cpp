@@ -136,6 +136,9 @@ TEST_F(BenchCli, SphTableQuick) {
   // Figure 5.1: the neighbour count along the settling, 6 points (steps 0..5) per size and k.
   expect_csv(d / "sph-table_settling.csv", {"particles", "neighbours", "step", "mean_neighbours"}, 24,
              {"step", "mean_neighbours"});
+  // Figure 5.4: the thesis's ratio where it has a row (N = 1000, k = 25); ours needs hash and grid runs.
+  expect_csv(d / "sph-table_fig54.csv", {"particles", "neighbours", "hash_over_grid", "thesis_spe_over_ppc"}, 1,
+             {"thesis_spe_over_ppc"});
   for (const char* png : {"sph-table_cost.png", "sph-table_efficiency.png", "sph-table_subtasks.png",
                           "sph-table_settling.png"})
     expect_png(d / png);
