@@ -104,11 +104,14 @@ class ThreadPool {
   // task must not throw.
   void run(std::int64_t blocks, std::int64_t runs, Task task, void* context) {
     if (blocks <= 0) return;
-    std::unique_lock lock(submit_, std::try_to_lock);
-    if (!lock.owns_lock() || inside_ || size() == 1 || blocks == 1) {
+    const auto serially = [&] {
       for (std::int64_t b = 0; b < blocks; ++b) task(context, b);
-      return;
-    }
+    };
+    // inside_ first: the caller of the running job holds submit_, and must not
+    // try to lock it again.
+    if (inside_ || size() == 1 || blocks == 1) return serially();
+    std::unique_lock lock(submit_, std::try_to_lock);
+    if (!lock.owns_lock()) return serially();
     task_ = task;
     context_ = context;
     blocks_ = blocks;
