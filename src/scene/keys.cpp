@@ -43,6 +43,9 @@ constexpr std::span<const EnumName<spatial::DuplicateCheck>> names_of(spatial::D
 constexpr std::span<const EnumName<spatial::TableBuild>> names_of(spatial::TableBuild) {
   return spatial::kTableBuildNames;
 }
+constexpr std::span<const EnumName<spatial::NeighbourHashes>> names_of(spatial::NeighbourHashes) {
+  return spatial::kNeighbourHashesNames;
+}
 constexpr std::span<const EnumName<spatial::CellTable>> names_of(spatial::CellTable) { return spatial::kCellTableNames; }
 constexpr std::span<const EnumName<gravity::Method>> names_of(gravity::Method) { return gravity::kMethodNames; }
 constexpr std::span<const EnumName<gravity::Scheme>> names_of(gravity::Scheme) { return gravity::kSchemeNames; }
@@ -377,6 +380,12 @@ std::vector<SceneKey> declare_scene_keys() {
                             "(`\"serial\"`, as the thesis's PPE built it: its serial portion); the same table",
                      .hashed = false},
             in_sph(&sph::SphParameters::table_build)));
+  add(field(SceneKey{.key = "sph.hash.neighbour_hashes", .section = "sph",
+                     .doc = "hash: the buckets of the 26 cells around a particle's, hashed by the search as it scans "
+                            "them (`\"on_the_fly\"`) or precomputed per particle while the table is built "
+                            "(`\"precomputed\"`, the thesis's section 4.2.3); the same pairs in the same order",
+                     .hashed = false},
+            in_sph(&sph::SphParameters::neighbour_hashes)));
 
   // [random_box] with the root key `particles`.
   add(field(SceneKey{.key = "particles", .section = "random_box", .unit = "particles", .range = kParticleCount,

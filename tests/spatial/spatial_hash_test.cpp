@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <map>
 #include <set>
 #include <utility>
@@ -92,6 +93,59 @@ TYPED_TEST(SpatialHashTest, TheSerialTableIsTheParallelTable) {
   serial_table.build(p, Real(0.1), 16001u, 97, TableBuild::Serial);
   EXPECT_EQ(serial_table.order(), parallel_table.order());
   EXPECT_EQ(serial_table.offsets(), parallel_table.offsets());
+  parallel::set_thread_count(saved);
+}
+
+// The thesis's precomputed neighbour hashes are, particle by particle, the
+// hashes of the 26 cells around its own in the search's scan order, and the
+// search that reads them makes the lists of the search that hashes on the fly:
+// the same rows, neighbours, r² bits and counters, for every place of the
+// duplicate check, on tables with many collisions, on 3 threads. Two particles
+// sit at the int32 clamp of the cell coordinates, where the neighbour cells wrap.
+TYPED_TEST(SpatialHashTest, PrecomputedNeighbourHashesGiveTheListsOfTheSearchThatHashesOnTheFly) {
+  using Real = TypeParam;
+  const int saved = parallel::thread_count();
+  parallel::set_thread_count(3);
+  for (std::uint32_t buckets : {1u, 3u, 11u, 389u, 1601u}) {
+    auto p = random_particles<Real>(900, -0.4, 1.2, 53 + buckets);
+    p.position.x[0] = p.position.x[1] = Real(1e30);  // cell i = INT32_MAX: its neighbour i + 1 wraps
+    const Real h = Real(0.11);
+    SpatialHash<Real> fly, pre;
+    fly.build(p, h, buckets, 41);
+    pre.build(p, h, buckets, 41, TableBuild::Parallel, NeighbourHashes::Precomputed);
+    EXPECT_TRUE(fly.neighbour_hashes().empty());
+    ASSERT_EQ(pre.neighbour_hashes().size(), p.size() * 26);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Cell c = pre.cells()[i];
+      std::size_t at = i * 26;
+      for (std::int64_t dk = -1; dk <= 1; ++dk)
+        for (std::int64_t dj = -1; dj <= 1; ++dj)
+          for (std::int64_t di = -1; di <= 1; ++di) {
+            if (di == 0 && dj == 0 && dk == 0) continue;
+            // The neighbour cell with 64-bit arithmetic, wrapped to 32 bits as the hash's unsigned products do.
+            auto wrapped = [](std::int32_t x, std::int64_t d) { return static_cast<std::int32_t>(static_cast<std::uint32_t>(x + d)); };
+            const Cell n{wrapped(c.i, di), wrapped(c.j, dj), wrapped(c.k, dk)};
+            ASSERT_EQ(pre.neighbour_hashes()[at++], hash_cell(n, buckets)) << "particle " << i;
+          }
+    }
+    for (DuplicateCheck check : {DuplicateCheck::Off, DuplicateCheck::BeforeDistance, DuplicateCheck::AfterDistance}) {
+      NeighbourList<Real> a, b;
+      SearchCounters ca, cb;
+      fly.find_neighbours(p, check, 41, a, [](auto, auto, auto, auto) {}, &ca);
+      pre.find_neighbours(p, check, 41, b, [](auto, auto, auto, auto) {}, &cb);
+      EXPECT_EQ(b.row_particle, a.row_particle);
+      EXPECT_EQ(b.offsets, a.offsets);
+      EXPECT_EQ(b.neighbour, a.neighbour) << buckets << " buckets";
+      ASSERT_EQ(b.r2.size(), a.r2.size());
+      EXPECT_EQ(std::memcmp(b.r2.data(), a.r2.data(), a.r2.size() * sizeof(Real)), 0);
+      EXPECT_EQ(cb.tests, ca.tests);
+      EXPECT_EQ(cb.redundant_tests, ca.redundant_tests);
+      EXPECT_EQ(cb.interactions, ca.interactions);
+    }
+    // A build without the option drops the hashes: the search hashes on the fly again.
+    pre.build(p, h, buckets, 41);
+    EXPECT_TRUE(pre.neighbour_hashes().empty());
+  }
   parallel::set_thread_count(saved);
 }
 

@@ -21,6 +21,14 @@
 // particle in bucket order, neighbours in scan order: deterministic for any
 // thread count.
 //
+// The 26 neighbour cells' buckets (NeighbourHashes): hashed by the search as
+// it scans them (ours, OnTheFly), or precomputed by build() into 26 hashes per
+// particle that the search reads (the thesis's, section 4.2.3; its Figure 5.2
+// and section 4.5 count this "neighbour hashing" as a pass of its own, timed
+// here as "forces.neighbour_hashes"). The thesis's SPEs ran that pass while
+// the PPE built the table; ours runs it after the table build, on every thread.
+// The buckets are the same, so the lists are the same either way (tested).
+//
 // Invariant: with the check on, the interactions are exactly the pairs of
 // brute_force_pairs() (tested).
 #pragma once
@@ -64,9 +72,13 @@ class SpatialHash {
  public:
   // Hashes the particles with cell length h (> 0) into `buckets` (≥ 1) buckets
   // and builds the table (its counting sort on one thread with TableBuild::Serial;
-  // the same table). With timers, the sort is the phase "forces.table".
+  // the same table). With NeighbourHashes::Precomputed it also writes the 26
+  // neighbour-cell hashes of every particle for the next find_neighbours().
+  // With timers, the sort is the phase "forces.table" and the neighbour
+  // hashes "forces.neighbour_hashes".
   void build(const ParticleSet<Real>& p, Real h, std::uint32_t buckets, std::size_t block_size,
-             TableBuild table = TableBuild::Parallel, PhaseTimers* timers = nullptr) {
+             TableBuild table = TableBuild::Parallel, NeighbourHashes neighbour_hashes = NeighbourHashes::OnTheFly,
+             PhaseTimers* timers = nullptr) {
     if (!(h > Real(0))) throw std::invalid_argument("spatial hash: cell length must be > 0");
     if (buckets == 0) throw std::invalid_argument("spatial hash: at least one bucket");
     h_ = h;
@@ -95,6 +107,14 @@ class SpatialHash {
         for (std::size_t slot = b; slot < e; ++slot) s[slot] = x[order[slot]];
       }
     });
+    neighbour_hashes_mode_ = neighbour_hashes;
+    if (neighbour_hashes == NeighbourHashes::Precomputed) {
+      std::optional<ScopedPhase> phase;
+      if (timers) phase.emplace(*timers, "forces.neighbour_hashes");
+      precompute_neighbour_hashes(buckets, block_size);
+    } else {
+      neighbour_hashes_.clear();
+    }
   }
 
   // Fills `out` with the interaction lists of every particle (see the header
@@ -114,6 +134,7 @@ class SpatialHash {
     const std::uint32_t buckets = bucket_count();
     const auto& order = sort_.order();
     const auto& offsets = sort_.offsets();
+    const bool precomputed = neighbour_hashes_mode_ == NeighbourHashes::Precomputed;
 
     parallel::for_blocks("neighbour_search", n, block_size, [&](std::size_t first, std::size_t last, std::size_t blk) {
       BlockList& list = block_lists_[blk];
@@ -126,11 +147,17 @@ class SpatialHash {
         const Real xi = sorted_position_[0][row], yi = sorted_position_[1][row], zi = sorted_position_[2][row];
         const Cell ci = sorted_cells_[row];
         const std::size_t row_begin = list.neighbour.size();
+        // The thesis's precomputed hashes of the 26 cells around ci, in scan order.
+        const std::uint32_t* around = precomputed ? neighbour_hashes_.data() + std::size_t(i) * kAround : nullptr;
+        int next_around = 0;
         for (int dk = -1; dk <= 1; ++dk)
           for (int dj = -1; dj <= 1; ++dj)
             for (int di = -1; di <= 1; ++di) {
               const Cell c{wrap(ci.i, di), wrap(ci.j, dj), wrap(ci.k, dk)};
-              const std::uint32_t b = hash_cell(c, buckets);
+              const bool centre = di == 0 && dj == 0 && dk == 0;
+              const std::uint32_t b = !precomputed ? hash_cell(c, buckets)
+                                      : centre     ? hashes_[i]
+                                                   : around[next_around++];
               for (std::uint32_t s = offsets[b]; s < offsets[b + 1]; ++s) {
                 if (s == row) continue;  // the particle itself
                 if (counters) {
@@ -170,6 +197,11 @@ class SpatialHash {
   const std::vector<std::uint32_t>& order() const { return sort_.order(); }
   const std::vector<Cell>& cells() const { return cells_; }        // per particle
   const std::vector<std::uint32_t>& hashes() const { return hashes_; }  // per particle
+  // The 26 neighbour-cell hashes of particle i at [26·i, 26·i + 26), in the
+  // search's scan order (dk, dj, di from −1 to 1, x fastest, the centre left
+  // out); empty unless the last build() was NeighbourHashes::Precomputed.
+  const std::vector<std::uint32_t>& neighbour_hashes() const { return neighbour_hashes_; }
+  static constexpr std::size_t kAround = 26;  // neighbour cells per particle
 
  private:
   struct BlockList {
@@ -182,6 +214,24 @@ class SpatialHash {
   // (cells at the int32 limits are clamped, see cell_coordinate()).
   static std::int32_t wrap(std::int32_t c, int d) {
     return static_cast<std::int32_t>(static_cast<std::uint32_t>(c) + static_cast<std::uint32_t>(d));
+  }
+
+  // The thesis's neighbour hashing pass: per particle, its cell (read) and the
+  // hashes of the 26 cells around it (written), in find_neighbours()' order.
+  void precompute_neighbour_hashes(std::uint32_t buckets, std::size_t block_size) {
+    const std::size_t n = cells_.size();
+    neighbour_hashes_.resize(n * kAround);
+    parallel::for_blocks("neighbour_hashes", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Cell ci = cells_[i];
+        std::uint32_t* out = neighbour_hashes_.data() + i * kAround;
+        for (int dk = -1; dk <= 1; ++dk)
+          for (int dj = -1; dj <= 1; ++dj)
+            for (int di = -1; di <= 1; ++di)
+              if (di != 0 || dj != 0 || dk != 0)
+                *out++ = hash_cell(Cell{wrap(ci.i, di), wrap(ci.j, dj), wrap(ci.k, dk)}, buckets);
+      }
+    });
   }
 
   // Concatenates the block lists into one CSR list, in block order.
@@ -207,6 +257,8 @@ class SpatialHash {
   parallel::CountingSort sort_;
   std::array<std::vector<Real>, 3> sorted_position_;  // positions in slot order, as the thesis's table holds them
   std::vector<Cell> sorted_cells_;                     // cells in slot order, for the cell-relation check
+  NeighbourHashes neighbour_hashes_mode_ = NeighbourHashes::OnTheFly;  // of the last build()
+  std::vector<std::uint32_t> neighbour_hashes_;        // kAround per particle (Precomputed only)
   std::vector<BlockList> block_lists_;  // kept between searches to avoid reallocation
 };
 

@@ -49,6 +49,7 @@ struct SphParameters {
   bool duplicate_check = true;     // hash: the cell-relation check of section 4.2.3
   spatial::DuplicateCheck check_placement = spatial::DuplicateCheck::BeforeDistance;  // hash: where it runs
   spatial::TableBuild table_build = spatial::TableBuild::Parallel;  // hash: the table on every thread or one
+  spatial::NeighbourHashes neighbour_hashes = spatial::NeighbourHashes::OnTheFly;  // hash: the 26 cells' hashes
   PressureForm pressure_form = PressureForm::Thesis;
   NegativePressure negative_pressure = NegativePressure::Keep;
   NeighbourSearch neighbour_search = NeighbourSearch::Grid;

@@ -202,7 +202,8 @@ class SphFluid final : public Solver<Real> {
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
            lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
-           hash_.offsets().capacity() * sizeof(std::uint32_t) + hash_.order().capacity() * sizeof(std::uint32_t);
+           hash_.offsets().capacity() * sizeof(std::uint32_t) + hash_.order().capacity() * sizeof(std::uint32_t) +
+           hash_.neighbour_hashes().capacity() * sizeof(std::uint32_t);
   }
 
  private:
@@ -251,7 +252,7 @@ class SphFluid final : public Solver<Real> {
     {
       PhaseScope phase(ctx, "forces.hash");
       hash_.build(p, h, params_.buckets ? params_.buckets : default_bucket_count(n), ctx.block_size,
-                  params_.table_build, ctx.timers);
+                  params_.table_build, params_.neighbour_hashes, ctx.timers);
     }
     {
       PhaseScope phase(ctx, "forces.search");
