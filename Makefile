@@ -69,7 +69,7 @@ demo: deps-build
 # regenerated from them. About 30 min on the 2-core machine.
 BENCH_OUT ?= bench/results
 bench: build
-	./build/swirl bench sph-table --strategy hash,hash+serial,grid --out $(BENCH_OUT)/sph-table
+	./build/swirl bench sph-table --strategy hash,hash+serial,hash+serial+precomputed+after_distance,grid --out $(BENCH_OUT)/sph-table
 	./build/swirl bench hash-stats --out $(BENCH_OUT)/hash-stats
 	./build/swirl bench bh-table --out $(BENCH_OUT)/bh-table
 	./build/swirl bench bh-lambda --out $(BENCH_OUT)/bh-lambda

@@ -83,6 +83,50 @@ inline constexpr double kThesisNoCheckGainPpcLow = 0.20;
 inline constexpr double kThesisNoCheckGainPpcHigh = 0.50;
 inline constexpr double kThesisNoCheckGainCell = 0.07;
 
+// Section 4.5 ("Bandwidth Requirements"): bytes moved per time step, with N
+// particles, M buckets and G neighbours per particle, pass by pass, ending
+// "TOTAL: 674N + 8M + 108N²/M + 48NG bytes/timestep. Of these are 452N bytes
+// transfered with 128B alignment and 128B or larger transfer sizes."
+struct ThesisBandwidthPass {
+  const char* pass;
+  double per_particle;    // × N
+  double per_bucket;      // × M
+  double per_n2_over_m;   // × N²/M (particles in the 27 scanned buckets)
+  double per_pair;        // × N·G
+};
+inline constexpr std::array<ThesisBandwidthPass, 8> kThesisBandwidthPasses{{
+    {"Hashing", 20, 0, 0, 0},
+    {"Building hash table", 46, 8, 0, 0},
+    {"Neighbor hashing", 120, 0, 0, 0},
+    {"Neighbor searching", 216, 0, 108, 8},
+    {"SPH calculations", 64, 0, 0, 40},
+    {"Collision handling - pass one", 64, 0, 0, 0},
+    {"Time integration", 112, 0, 0, 0},
+    {"Collision handling - pass two", 32, 0, 0, 0},
+}};
+inline constexpr double kThesisBandwidthAlignedPerParticle = 452;  // "452N bytes ... 128B alignment"
+// Its example: "50000 particles and a hash table with 75000 buckets, and each
+// particle has 30 neighbors on average, and we want to run the simulation at
+// 50Hz. The required bandwidth should be roughly 5GB/s (of which 20% are 128B
+// sized/aligned)."
+inline constexpr std::size_t kThesisBandwidthExampleParticles = 50000;
+inline constexpr std::size_t kThesisBandwidthExampleBuckets = 75000;
+inline constexpr double kThesisBandwidthExampleNeighbours = 30;
+inline constexpr double kThesisBandwidthExampleHz = 50;
+inline constexpr double kThesisBandwidthExampleGBs = 5;          // "roughly 5GB/s"
+inline constexpr double kThesisBandwidthExampleAligned = 0.20;   // "of which 20% are 128B sized/aligned"
+// "For the Cell it is in practice possible to achieve about 15-20GB/s throughput [29]".
+inline constexpr double kThesisCellPracticalGBsLow = 15;
+inline constexpr double kThesisCellPracticalGBsHigh = 20;
+
+// Bytes per step of the thesis's model (decimal units as the thesis's GB/s).
+inline constexpr double thesis_bandwidth_bytes(double n, double m, double g) {
+  double bytes = 0;
+  for (const auto& p : kThesisBandwidthPasses)
+    bytes += p.per_particle * n + p.per_bucket * m + p.per_n2_over_m * n * n / m + p.per_pair * n * g;
+  return bytes;
+}
+
 // ---- Paper (seed 003) ----------------------------------------------------
 
 // Section 5: defaults of every experiment.
@@ -141,9 +185,21 @@ inline constexpr std::array<PaperSpeedupRow, 4> kPaperFig9And10{{
     {true, 32768, 1.98, 3.86, 7.32},
 }};
 
-// Figure 11: speedup of 8 SPEs over the Xeon at 4096 particles (text).
-inline constexpr double kPaperFig11InitialAt4096 = 6.22;
-inline constexpr double kPaperFig11EnhancedAt4096 = 7.4;
+// Figure 11: speedup of 8 SPEs over the Xeon at 4096 particles (text); the
+// abstract: "outperform Intel Xeon by a factor of 5.8 and 7.1 for 8192".
+struct PaperOverXeon {
+  std::size_t particles;
+  double initial, enhanced;
+  const char* source;
+};
+inline constexpr std::array<PaperOverXeon, 2> kPaperOverXeon{{
+    {4096, 6.22, 7.4, "Fig. 11 text"},
+    {8192, 5.8, 7.1, "abstract"},
+}};
+// Section 5: the enhanced parallelization "resulting in a speedup of 1.4 for
+// 32768 particles" over the initial one (8 SPEs, by context).
+inline constexpr double kPaperEnhancedOverInitial = 1.4;
+inline constexpr std::size_t kPaperEnhancedOverInitialParticles = 32768;
 // Section 5: local trees generated per step (sub-domain scheme) for 1024, 8192, 32768 particles.
 inline constexpr std::array<std::pair<std::size_t, std::size_t>, 3> kPaperTreesPerStep{{{1024, 8}, {8192, 64}, {32768, 200}}};
 
@@ -176,6 +232,18 @@ inline constexpr std::array<PaperTable1Column, 6> kPaperTable1{{
     {16384, 43.5, 1.1, 3851.5, 94.4, 20.3, 1.2, 46.1, 435.8, 9.7, 3961.6, 542.2},
     {32768, 75.5, 2.1, 11573.9, 2854.7, 41.6, 25.5, 116.8, 2052.7, 26.2, 11807.9, 2369.0},
 }};
+
+// Section 5, the text around Table 1 (enhanced parallelization, 8 SPEs),
+// shares of the total execution time unless said otherwise.
+struct PaperTable1Text {
+  double ppe_share_1024 = 0.072, ppe_share_32768 = 0.0084;          // PPE-specific: global tree construction
+  double spe_tree_share_1024 = 0.044, spe_tree_share_32768 = 0.0054;  // tree construction on the SPEs
+  double update_barrier_share_32768 = 0.001;                         // barrier after the update phase
+  double force_barrier_share_32768 = 0.0127;                         // barrier after the force phase
+  double force_share_low = 0.883, force_share_high = 0.989;          // of the total computation time
+  double communication_over_computation = 0.19;                      // average over the sizes
+};
+inline constexpr PaperTable1Text kPaperTable1Text{};
 
 inline std::optional<PaperTable1Column> paper_table1(std::size_t particles) {
   for (const auto& c : kPaperTable1)

@@ -18,22 +18,35 @@
 // from a copy of that state.
 //
 // Subtasks (Figure 5.2) from the step's phase timers (core/phase_timers.hpp):
-//   structure build         the hash strategy: "forces.hash" (hashing + table
-//                           build, one timer); the grid strategy: "forces.sort"
-//                           + "forces.cells" (the shared order's sort and the
-//                           cell table); any other "forces.*" phase not named below
+//   structure build         the hash strategy: "forces.hash" (hashing, the
+//                           table build "forces.table", the copy into bucket
+//                           order and, precomputed, the neighbour hashing
+//                           "forces.neighbour_hashes": the last two reported
+//                           as "of which" shares); the grid strategy:
+//                           "forces.sort" + "forces.cells" (the shared order's
+//                           sort and the cell table); any other "forces.*"
+//                           phase not named below
 //   neighbour search + density  "forces.search" (grid: "forces.density", whose
 //                           search runs on the fly; its force pass searches again)
 //   SPH forces              "forces.sph"
 //   integration + collision "integrate" (drift, box passes, kick)
 //   other                   the rest of the wall time: zeroing accelerations,
 //                           the loop around the step
-// Hashing and the table build are one timer (SpatialHash::build), so they are
-// reported together.
+// Figure 5.6 (table fig56): the 1-thread shares at the last k, hashing +
+// table + neighbour hashing + search together beside the thesis's one-SPE 80 %.
 //
-// A strategy is a sph.neighbour_search value, optionally followed by grid
+// Section 4.5 (tables stream, bandwidth, bandwidth_passes, bandwidth_thesis):
+// bytes per particle per step from our data layout (traffic_passes(), two
+// bounds: every access / streamed; docs/performance/sph-bandwidth.md) times N
+// times the measured Hz, against a STREAM triad run on the same thread counts
+// in this process; the thesis's own model beside it (bench_seeds.hpp).
+//
+// A strategy is a sph.neighbour_search value, optionally followed by
 // settings joined with '+': "serial" or "parallel" (the hash's
 // sph.hash.table_build: "hash+serial" is the thesis's serial table build),
+// "precomputed" or "on_the_fly" (sph.hash.neighbour_hashes), "after_distance"
+// or "before_distance" (sph.hash.check_placement): the thesis's scheme as
+// written is "hash+serial+precomputed+after_distance",
 // "rows" or "morton" (sph.grid.cell_order),
 // "dense" or "hashed" (sph.grid.table) and "skin=X" (sph.grid.skin in m) or
 // "skin=Xh" (X times the smoothing length), e.g.
@@ -46,8 +59,10 @@
 // than p times, or slower than on one thread) is timing noise, and the row's
 // "Karp-Flatt noise" column names those stages.
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -58,12 +73,14 @@
 
 #include "bench.hpp"
 #include "bench_seeds.hpp"
+#include "swirl/core/aligned.hpp"
 #include "swirl/core/enum_names.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/blow_up.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/spatial/hash_statistics.hpp"
+#include "swirl/sph/parameters.hpp"
 
 namespace swirl::cli::bench {
 namespace {
@@ -153,6 +170,7 @@ struct Timing {
   std::size_t warnings = 0;  // guard events
   double structure = 0, search = 0, forces = 0, integrate = 0;  // seconds per subtask
   double table = 0;  // the hash's table build (counting sort), part of `structure`
+  double neighbour_hashes = 0;  // the hash's precomputed neighbour hashes, part of `structure`
 };
 
 // Times `steps` steps from the settled state with `threads` threads.
@@ -180,6 +198,7 @@ Timing time_steps(const scene::Scene& scene, const ParticleSet<float>& start, in
     else if (name == "forces.sph") t.forces += sec;
     else if (name == "integrate") t.integrate += sec;
     else if (name == "forces.table") t.table += sec;  // timed inside forces.hash
+    else if (name == "forces.neighbour_hashes") t.neighbour_hashes += sec;  // inside forces.hash too
     else if (name.rfind("forces.", 0) == 0) t.structure += sec;
   }
   return t;
@@ -222,6 +241,10 @@ std::vector<std::string> strategy_overrides(const std::string& strategy, double 
       out.push_back(fmt::format("sph.grid.cell_order=\"{}\"", part));
     } else if (part == "serial" || part == "parallel") {
       out.push_back(fmt::format("sph.hash.table_build=\"{}\"", part));
+    } else if (part == "precomputed" || part == "on_the_fly") {
+      out.push_back(fmt::format("sph.hash.neighbour_hashes=\"{}\"", part));
+    } else if (part == "after_distance" || part == "before_distance") {
+      out.push_back(fmt::format("sph.hash.check_placement=\"{}\"", part));
     } else if (part == "dense" || part == "hashed") {
       out.push_back(fmt::format("sph.grid.table=\"{}\"", part));
     } else if (part.rfind("skin=", 0) == 0) {
@@ -241,7 +264,7 @@ std::vector<std::string> strategy_overrides(const std::string& strategy, double 
     } else {
       throw std::invalid_argument(
           fmt::format("--strategy '{}': unknown setting '{}' (allowed after '+': rows, morton, dense, hashed, skin=X, "
-                      "skin=Xh, serial, parallel)", strategy, part));
+                      "skin=Xh, serial, parallel, precomputed, on_the_fly, after_distance, before_distance)", strategy, part));
     }
   }
   return out;
@@ -253,6 +276,117 @@ double karp_flatt(double t1, double tp, int p) {
   if (!(t1 > 0) || !(tp > 0) || p < 2) return NAN;
   const double inv_s = tp / t1, inv_p = 1.0 / p;
   return (inv_s - inv_p) / (1 - inv_p);
+}
+
+// ---- Section 4.5: bytes moved per particle per step, and this machine's bandwidth.
+
+// A STREAM triad a[i] = b[i] + s·c[i] over three arrays of `n` doubles on
+// `threads` threads (pinned blocks: each thread touches, first and in every
+// repetition, the same contiguous part). GB/s = 24·n bytes (two reads, one
+// write; write-allocate traffic not counted, as STREAM counts) over the best
+// of `reps` repetitions, decimal GB as the thesis's.
+double triad_gbps(std::size_t n, int threads, int reps) {
+  parallel::set_thread_count(threads);
+  AlignedVector<double> a(n), b(n), c(n);
+  const std::size_t block = std::max<std::size_t>(4096, n / 256);
+  parallel::for_blocks_pinned("triad_init", n, block, [&](std::size_t first, std::size_t last, std::size_t) {
+    for (std::size_t i = first; i < last; ++i) {
+      a[i] = 0;
+      b[i] = 1;
+      c[i] = 2;
+    }
+  });
+  const double scalar = 3;
+  double best = 0;
+  for (int r = 0; r < reps; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    parallel::for_blocks_pinned("triad", n, block, [&](std::size_t first, std::size_t last, std::size_t) {
+      double* __restrict out = a.data();
+      const double* __restrict x = b.data();
+      const double* __restrict y = c.data();
+      for (std::size_t i = first; i < last; ++i) out[i] = x[i] + scalar * y[i];
+    });
+    const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (sec > 0) best = std::max(best, 24.0 * double(n) / sec / 1e9);
+  }
+  if (a[n / 2] != 7) throw std::logic_error("triad: wrong result");  // also keeps the loop
+  return best;
+}
+
+// What a step's bytes depend on, per particle (see docs/performance/sph-bandwidth.md).
+struct TrafficInputs {
+  double n = 0;          // particles
+  double buckets = 0;    // the hash's M
+  double neighbours = 0; // G, measured, self excluded
+  double candidates_hash = 0;  // entries of the 27 scanned buckets per particle (collisions included)
+  double candidates_grid = 0;  // particles of the 27 cells per particle (self included)
+  bool precomputed = false;    // the hash's 26 neighbour hashes precomputed
+  int sort_passes = 1;         // the grid's radix passes (8-bit digits of the cell key)
+};
+
+// One pass of a step: bytes per particle (+ per bucket, per candidate, per
+// neighbour pair), in two bounds. "access": every load and store counted, a
+// neighbour's data once per pair or candidate (the thesis's model: an SPE has
+// no cache, every access is a DMA); "streamed": every array once per pass,
+// neighbours' data from cache (the least the pass must move).
+struct TrafficPass {
+  const char* name;
+  double particle_access, particle_streamed;
+  double bucket_access, bucket_streamed;
+  double candidate_access; // streamed: 0
+  double pair_access, pair_streamed;
+};
+
+// Our passes, from the data layout (float: 4 B per real, 4 B indices, 8 B CSR offsets).
+std::vector<TrafficPass> traffic_passes(bool grid, const TrafficInputs& in) {
+  const double cells_per_particle = in.neighbours > 0 ? 4.18879 / in.neighbours : 1.0;  // h³ cells, G in (4/3)πh³
+  const double integrate = 134;  // drift 62 (x,v,a in; x, a_prev out; flags), kick 60 (x,v,a,a_prev in; v out), a zeroed 12
+  if (grid) {
+    return {
+        // bounds 12, keys 12 + 8, P radix passes of (count 8 + key, index in 12 + out 12), reorder: order 4 + 68 in + 68 out.
+        {"hashing + table (grid: keys, radix sort, reorder of every field)", 172 + 32.0 * in.sort_passes,
+         172 + 32.0 * in.sort_passes, 0, 0, 0, 0, 0},
+        // keys 8, a dense table entry (4 B) per cell.
+        {"cell table (grid: forces.cells)", 8 + 4 * cells_per_particle, 8 + 4 * cells_per_particle, 0, 0, 0, 0, 0},
+        {"neighbour hashing (none)", 0, 0, 0, 0, 0, 0, 0},
+        // own x, m 16, key 8, 9 row ranges (2 × 4 B) per cell, out ρ, p, V, pV 16; per candidate x, m 16.
+        {"search + density (grid: density pass)", 40 + 72 * cells_per_particle, 40, 0, 0, 16, 0, 0},
+        // own x, v 24, p, ρ 8, V, pV 8, key 8, ranges, a in and out 24; per candidate x, v, V, pV 32.
+        {"SPH forces", 72 + 72 * cells_per_particle, 72, 0, 0, 32, 0, 0},
+        {"integration + collision", integrate, integrate, 0, 0, 0, 0, 0},
+    };
+  }
+  return {
+      // x 12 in, cell 12 + hash 4 out.
+      {"hashing (+ positions and cells into bucket order)", 28 + 52, 28 + 52, 0, 0, 0, 0, 0},
+      // count: key 4, counter 8; scatter: key 4, cursor 8, order 4; per bucket 20 (clear, sum, offsets).
+      {"hash table build (counting sort)", 28, 28, 20, 20, 0, 0, 0},
+      // cell 12 in, 26 hashes out.
+      {"neighbour hashing", in.precomputed ? 116.0 : 0.0, in.precomputed ? 116.0 : 0.0, 0, 0, 0, 0, 0},
+      // access: order, sorted x and cell 28, 27 buckets × 2 offsets × 4 = 216, list bookkeeping and gather 40
+      // (+ own hash and 26 neighbour hashes 108); per candidate sorted cell and x 24; per pair: order 4,
+      // list out 8, density reads it back 8 and m_j 4, the gather copies it 16.
+      // streamed: the offset table once (4·M), m once (4), lists 24 per pair.
+      {"search + density", 284 + (in.precomputed ? 108.0 : 0.0), 72 + (in.precomputed ? 108.0 : 0.0), 0, 4, 24, 40, 24},
+      // row 4 + offsets 8, own x, v, p, ρ 32 (streamed: + m 4), a in and out 24; per pair list 8 + m, ρ, p, x, v of j 36.
+      {"SPH forces", 68, 72, 0, 0, 0, 44, 8},
+      {"integration + collision", integrate, integrate, 0, 0, 0, 0, 0},
+  };
+}
+
+struct Traffic {
+  double access = 0, streamed = 0;  // bytes per particle per step
+};
+Traffic traffic_per_particle(const std::vector<TrafficPass>& passes, bool grid, const TrafficInputs& in) {
+  const double buckets_per_particle = in.n > 0 ? in.buckets / in.n : 0;
+  const double candidates = grid ? in.candidates_grid : in.candidates_hash;
+  Traffic t;
+  for (const auto& p : passes) {
+    t.access += p.particle_access + p.bucket_access * buckets_per_particle + p.candidate_access * candidates +
+                p.pair_access * in.neighbours;
+    t.streamed += p.particle_streamed + p.bucket_streamed * buckets_per_particle + p.pair_streamed * in.neighbours;
+  }
+  return t;
 }
 
 }  // namespace
@@ -297,7 +431,8 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
                {"kf_forces", "e: forces"},
                {"kf_integrate", "e: integrate + collide"},
                {"kf_step", "e: whole step"},
-               {"kf_noise", "Karp-Flatt noise (e outside 0-1)"}};
+               {"kf_noise", "Karp-Flatt noise (e outside 0-1)"},
+               {"share_neighbour_hashes", "of which the precomputed neighbour hashes %"}};
   Table settled;
   settled.name = "settle";
   settled.title = "Calibration and settling (Figure 5.1): neighbours at the random start and after settling";
@@ -315,6 +450,82 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
   // 1-thread rates by (N, k, strategy), for Figure 5.4's ratio.
   std::vector<std::tuple<std::size_t, double, std::string, double>> one_thread_hz;
 
+  // This machine's memory bandwidth (section 4.5's limit), on 1 thread and on every count timed.
+  const std::size_t triad_n = common.quick ? std::size_t{1} << 20 : std::size_t{1} << 24;
+  const int triad_reps = common.quick ? 2 : 5;
+  Table stream;
+  stream.name = "stream";
+  stream.title = "Memory bandwidth of this machine: a STREAM triad a = b + s*c (section 4.5's limit)";
+  stream.columns = {{"threads", "threads"}, {"array_mib", "MiB per array (3 arrays)"}, {"repetitions", "repetitions"},
+                    {"triad_gbs", "triad GB/s (best)"},
+                    {"thesis_cell_practical_gbs", "thesis Cell, practical GB/s (section 4.5, cited)"}};
+  std::vector<std::pair<int, double>> triad;
+  for (int p : threads) {
+    progress(fmt::format("sph-table: memory bandwidth (triad, 3 x {} MiB) on {} thread(s)", triad_n * 8 >> 20, p));
+    triad.emplace_back(p, triad_gbps(triad_n, p, triad_reps));
+    stream.add({integer(p), integer(static_cast<long long>(triad_n * 8 >> 20)), integer(triad_reps),
+                number(triad.back().second, 2),
+                text(fmt::format("{:.0f}-{:.0f}", seeds::kThesisCellPracticalGBsLow, seeds::kThesisCellPracticalGBsHigh))});
+  }
+  auto triad_at = [&](int p) -> double {
+    for (const auto& [tp, gbs] : triad)
+      if (tp == p) return gbs;
+    return NAN;
+  };
+
+  // Figure 5.6 (one SPE: hashing and search "together 80 %") beside our 1-thread subtasks.
+  const double k_fig = a.neighbours.back();
+  Table fig56;
+  fig56.name = "fig56";
+  fig56.title = fmt::format("Figure 5.6: hashing + neighbour search as a share of the step, ours on 1 thread (k aimed {}) "
+                            "beside the thesis's 1 SPE", k_fig);
+  fig56.columns = {{"particles", "N"},
+                   {"neighbours", "k aimed"},
+                   {"strategy", "strategy"},
+                   {"source", "source"},
+                   {"share_hashing", "hashing % (hash: hash + copy into bucket order; grid: sort + cells)"},
+                   {"share_table", "table build %"},
+                   {"share_neighbour_hashes", "neighbour hashing %"},
+                   {"share_search_density", "search + density %"},
+                   {"share_hash_search", "hashing + search, together %"},
+                   {"share_forces", "forces %"},
+                   {"share_rest", "integrate + other %"},
+                   {"thesis_spe_hash_search", "thesis 1 SPE (Figure 5.6 text, simulated): hashing + search %"}};
+
+  // Section 4.5's model applied to every timed row at k_fig.
+  Table bandwidth;
+  bandwidth.name = "bandwidth";
+  bandwidth.title = fmt::format("Section 4.5: memory traffic the measured step rate needs, against this machine's triad "
+                                "(k aimed {})", k_fig);
+  bandwidth.columns = {{"particles", "N"},
+                       {"neighbours", "k aimed"},
+                       {"strategy", "strategy"},
+                       {"threads", "threads"},
+                       {"hz", "Hz"},
+                       {"measured_neighbours", "G measured"},
+                       {"candidates", "candidates / particle"},
+                       {"bytes_access", "B / particle / step, every access"},
+                       {"bytes_streamed", "B / particle / step, streamed"},
+                       {"gbs_access", "GB/s, every access"},
+                       {"gbs_streamed", "GB/s, streamed"},
+                       {"triad_gbs", "triad GB/s, same threads"},
+                       {"fraction_access_pct", "% of triad, every access"},
+                       {"fraction_streamed_pct", "% of triad, streamed"},
+                       {"thesis_bytes", "thesis model B / particle / step (section 4.5, M = 1.6N, G = 25)"},
+                       {"thesis_8spe_gbs", "thesis 8 SPEs GB/s (model x Table 5.3 rate)"},
+                       {"thesis_8spe_fraction_pct", "thesis 8 SPEs % of the Cell's 15-20 GB/s"}};
+  Table passes;
+  passes.name = "bandwidth_passes";
+  passes.title = "Section 4.5 pass by pass: bytes per particle per step, the thesis's model and ours";
+  passes.columns = {{"pass", "pass"},
+                    {"thesis", "thesis (section 4.5, its formula at our N, M, G)"},
+                    {"hash_access", "hash, every access"},
+                    {"hash_streamed", "hash, streamed"},
+                    {"hash_precomputed_access", "hash+precomputed, every access"},
+                    {"grid_access", "grid, every access"},
+                    {"grid_streamed", "grid, streamed"}};
+  std::optional<TrafficInputs> largest;  // the largest N at k_fig: the per-pass table's set-up
+
   for (std::size_t n : a.sizes) {
     for (double k : a.neighbours) {
       progress(fmt::format("sph-table: N = {}, k = {}: settling {} steps", n, k, a.settle));
@@ -328,6 +539,16 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
         curve.add({integer(static_cast<long long>(n)), text(k_text(k)), integer(step), number(mean_k, 3)});
       const auto seed = seeds::thesis_sph_row(n);
       const int steps = timed_steps(a.steps, n);
+      // Candidates per particle of the settled state (section 4.5's model): the hash's
+      // scanned-bucket entries, and the grid's 27 cells (the same cells, no collisions, self included).
+      TrafficInputs inputs;
+      inputs.n = double(n);
+      if (k == k_fig) {
+        const float h = static_cast<float>(base.scene.sph->smoothing_length);
+        const auto st = spatial::hash_statistics(base.particles, h, sph::default_bucket_count(n), base.scene.block_size);
+        inputs.candidates_hash = double(st.tests) / double(n);
+        inputs.candidates_grid = double(st.tests - st.redundant_tests) / double(n) + 1;
+      }
       for (const auto& strategy : strategies) {
         const std::vector<std::string> extra =
             strategy_overrides(strategy, base.scene.sph ? base.scene.sph->smoothing_length : 0.0);
@@ -351,6 +572,47 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
             return std::isfinite(e) ? number(e, 3) : none();
           };
           const double other = std::max(0.0, m.seconds - m.structure - m.search - m.forces - m.integrate);
+          const bool is_grid = scene.sph->neighbour_search == sph::NeighbourSearch::Grid;
+          if (k == k_fig) {
+            TrafficInputs in = inputs;
+            in.buckets = scene.sph->buckets ? scene.sph->buckets : sph::default_bucket_count(n);
+            in.neighbours = m.mean_k;
+            in.precomputed = scene.sph->neighbour_hashes == spatial::NeighbourHashes::Precomputed;
+            const double cells = std::ceil(double(n) * 4.18879 / std::max(1.0, m.mean_k));
+            in.sort_passes = std::max(1, static_cast<int>((std::bit_width(static_cast<std::uint64_t>(cells)) + 7) / 8));
+            const Traffic tr = traffic_per_particle(traffic_passes(is_grid, in), is_grid, in);
+            const double hz = steps / m.seconds, gbs_a = tr.access * double(n) * hz / 1e9,
+                         gbs_s = tr.streamed * double(n) * hz / 1e9, mem = triad_at(p);
+            const bool thesis_row = seed && k == 25;
+            const double thesis_bytes =
+                seeds::thesis_bandwidth_bytes(double(n), double(sph::default_bucket_count(n)), 25) / double(n);
+            const double thesis_gbs = thesis_row ? thesis_bytes * double(n) * seed->cell_8spe_hz / 1e9 : NAN;
+            bandwidth.add({integer(static_cast<long long>(n)), text(k_text(k)), text(strategy_name(strategy, scene)),
+                           integer(p), number(hz, 1), number(m.mean_k, 1),
+                           number(is_grid ? in.candidates_grid : in.candidates_hash, 1), number(tr.access, 0),
+                           number(tr.streamed, 0), number(gbs_a, 3), number(gbs_s, 3), number(mem, 2),
+                           number(100 * gbs_a / mem, 2), number(100 * gbs_s / mem, 2),
+                           k == 25 ? number(thesis_bytes, 0) : none(), thesis_row ? number(thesis_gbs, 2) : none(),
+                           thesis_row ? text(fmt::format("{:.0f}-{:.0f}", 100 * thesis_gbs / seeds::kThesisCellPracticalGBsHigh,
+                                                         100 * thesis_gbs / seeds::kThesisCellPracticalGBsLow))
+                                      : none()});
+            if (p == 1 && (!largest || largest->n < in.n || (largest->n == in.n && !is_grid))) {
+              largest = in;
+              largest->precomputed = false;
+            }
+          }
+          if (p == 1 && k == k_fig) {
+            const double pct1 = 100 / m.seconds;
+            const bool precomputed = scene.sph->neighbour_hashes == spatial::NeighbourHashes::Precomputed;
+            const double hashing = m.structure - m.table - m.neighbour_hashes;
+            fig56.add({integer(static_cast<long long>(n)), text(k_text(k)), text(strategy_name(strategy, scene)),
+                       text(fmt::format("ours, 1 thread, {}", strategy_name(strategy, scene))),
+                       number(pct1 * hashing, 1), is_grid ? none() : number(pct1 * m.table, 1),
+                       precomputed ? number(pct1 * m.neighbour_hashes, 1) : none(), number(pct1 * m.search, 1),
+                       number(pct1 * (m.structure + m.search), 1), number(pct1 * m.forces, 1),
+                       number(pct1 * (m.seconds - m.structure - m.search - m.forces), 1),
+                       number(100 * seeds::kThesisSpeHashSearchShare, 0)});
+          }
           const double pct = 100 / m.seconds;
           const bool k15 = k == 15, k25 = k == 25;
           const double speedup = one_thread > 0 ? one_thread / m.seconds : NAN;
@@ -366,7 +628,8 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
                  seed && k25 ? number(seed->cell_8spe_hz / seed->cell_1spe_hz / seeds::kThesisCellSpes, 2) : none(),
                  number(m.sorts, 3), kf(one.structure, m.structure, "structure"), kf(one.search, m.search, "search"),
                  kf(one.forces, m.forces, "forces"), kf(one.integrate, m.integrate, "integrate"),
-                 kf(one.seconds, m.seconds, "step"), has_one ? text(noise) : none()});
+                 kf(one.seconds, m.seconds, "step"), has_one ? text(noise) : none(),
+                 m.neighbour_hashes > 0 ? number(pct * m.neighbour_hashes, 1) : none()});
         }
       }
     }
@@ -412,7 +675,77 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
                  hash && grid ? number(*hash / *grid, 3) : none(),
                  seed && k == 25 ? number(seed->cell_1spe_hz / seed->ppc970_k25_hz, 2) : none()});
     }
-  r.tables = {t, settled, curve, fig54};
+  // The per-pass comparison at the largest N timed at k_fig (G, candidates and M measured there).
+  if (largest) {
+    TrafficInputs in = *largest;
+    TrafficInputs pre = in;
+    pre.precomputed = true;
+    const auto hash = traffic_passes(false, in), hash_pre = traffic_passes(false, pre), grid = traffic_passes(true, in);
+    const double bpp = in.buckets / in.n;
+    auto bytes = [&](const TrafficPass& p, bool access, double candidates) {
+      return access ? p.particle_access + p.bucket_access * bpp + p.candidate_access * candidates + p.pair_access * in.neighbours
+                    : p.particle_streamed + p.bucket_streamed * bpp + p.pair_streamed * in.neighbours;
+    };
+    auto thesis_pass = [&](std::size_t i) {
+      const auto& seed = seeds::kThesisBandwidthPasses[i];
+      return seed.per_particle + seed.per_bucket * bpp + seed.per_n2_over_m / bpp + seed.per_pair * in.neighbours;
+    };
+    double totals[6] = {};
+    for (std::size_t i = 0; i < hash.size(); ++i) {
+      // Our six passes against the thesis's eight: its three integration and collision passes are our one.
+      const double thesis = i < 5 ? thesis_pass(i) : thesis_pass(5) + thesis_pass(6) + thesis_pass(7);
+      const double row[6] = {thesis,
+                             bytes(hash[i], true, in.candidates_hash),
+                             bytes(hash[i], false, in.candidates_hash),
+                             bytes(hash_pre[i], true, in.candidates_hash),
+                             bytes(grid[i], true, in.candidates_grid),
+                             bytes(grid[i], false, in.candidates_grid)};
+      for (int c = 0; c < 6; ++c) totals[c] += row[c];
+      passes.add({text(fmt::format("{} (thesis: {})", hash[i].name,
+                                   i < 5 ? std::string(seeds::kThesisBandwidthPasses[i].pass)
+                                         : "Collision one + Time integration + Collision two")),
+                  number(row[0], 0), number(row[1], 0), number(row[2], 0), number(row[3], 0), number(row[4], 0),
+                  number(row[5], 0)});
+    }
+    passes.add({text(fmt::format("total at N = {:.0f}, M = {:.0f}, G = {:.1f}, candidates {:.1f} (hash) / {:.1f} (grid)",
+                                 in.n, in.buckets, in.neighbours, in.candidates_hash, in.candidates_grid)),
+                number(totals[0], 0), number(totals[1], 0), number(totals[2], 0), number(totals[3], 0),
+                number(totals[4], 0), number(totals[5], 0)});
+  }
+  // The thesis's own figures: its example, recomputed from its formula, and Table 5.3's 8-SPE rates.
+  Table seed_bw;
+  seed_bw.name = "bandwidth_thesis";
+  seed_bw.title = "Section 4.5's model with the thesis's own figures (its example; Table 5.3's simulated 8-SPE rates, G = 25)";
+  seed_bw.columns = {{"case", "case"},          {"particles", "N"},
+                     {"buckets", "M"},          {"neighbours", "G"},
+                     {"hz", "Hz"},              {"bytes_per_particle", "B / particle / step (674 + 8M/N + 108N/M + 48G)"},
+                     {"gbs", "GB/s (model x Hz)"}, {"gbs_stated", "GB/s, the thesis's text"},
+                     {"aligned_pct", "128 B-aligned % (452N of the total)"},
+                     {"fraction_pct", "% of the Cell's practical 15-20 GB/s"}};
+  {
+    const double n = double(seeds::kThesisBandwidthExampleParticles), m = double(seeds::kThesisBandwidthExampleBuckets);
+    const double bytes = seeds::thesis_bandwidth_bytes(n, m, seeds::kThesisBandwidthExampleNeighbours);
+    const double gbs = bytes * seeds::kThesisBandwidthExampleHz / 1e9;
+    seed_bw.add({text("section 4.5 example"), integer(static_cast<long long>(n)), integer(static_cast<long long>(m)),
+                 number(seeds::kThesisBandwidthExampleNeighbours, 0), number(seeds::kThesisBandwidthExampleHz, 0),
+                 number(bytes / n, 0), number(gbs, 2),
+                 text(fmt::format("{:.0f} ({:.0f} % aligned)", seeds::kThesisBandwidthExampleGBs,
+                                  100 * seeds::kThesisBandwidthExampleAligned)),
+                 number(100 * seeds::kThesisBandwidthAlignedPerParticle * n / bytes, 1),
+                 text(fmt::format("{:.0f}-{:.0f}", 100 * gbs / seeds::kThesisCellPracticalGBsHigh,
+                                  100 * gbs / seeds::kThesisCellPracticalGBsLow))});
+    for (const auto& row : seeds::kThesisSph) {
+      const double rn = double(row.particles), rm = double(sph::default_bucket_count(row.particles));
+      const double b = seeds::thesis_bandwidth_bytes(rn, rm, 25);
+      const double g = b * row.cell_8spe_hz / 1e9;
+      seed_bw.add({text("Table 5.3, 8 SPEs (simulated)"), integer(static_cast<long long>(rn)),
+                   integer(static_cast<long long>(rm)), number(25, 0), number(row.cell_8spe_hz, 1), number(b / rn, 0),
+                   number(g, 2), none(), number(100 * seeds::kThesisBandwidthAlignedPerParticle * rn / b, 1),
+                   text(fmt::format("{:.0f}-{:.0f}", 100 * g / seeds::kThesisCellPracticalGBsHigh,
+                                    100 * g / seeds::kThesisCellPracticalGBsLow))});
+    }
+  }
+  r.tables = {t, settled, curve, fig54, fig56, stream, bandwidth, passes, seed_bw};
   r.notes = fmt::format(
       "The thesis's PPC 970 figures are measured (one core of a 2.0 GHz G5); its Cell figures come from IBM's "
       "simulator, which did not model memory transfers. k aimed 15 and 25 stand for the thesis's \"about 15\" and "
@@ -437,9 +770,23 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
       "strategy's 1-thread row: the serial fraction the timings imply (0 = perfect scaling, 1 = none); a value "
       "outside 0-1 cannot be a serial fraction, it is timing noise (a short stage on a shared machine), and the "
       "column \"Karp-Flatt noise\" names those stages in each row. "
-      "\"grid sorts / step\" < 1 when a Verlet skin (strategy +skin=...) let steps reuse the last sort.",
+      "\"grid sorts / step\" < 1 when a Verlet skin (strategy +skin=...) let steps reuse the last sort. "
+      "Figure 5.6 (table fig56): the thesis's text gives one figure for one SPE, hashing and neighbour search "
+      "\"together 80% of total cost\" (simulated); beside it, ours on 1 thread at k aimed {}: hashing (+ the copy into "
+      "bucket order) + table build + precomputed neighbour hashes + search with density, of the whole step (the "
+      "grid's sort, cell table and density pass for contrast; the grid's force pass searches again, counted under "
+      "forces). The thesis's scheme as written is the strategy hash+serial+precomputed+after_distance (its serial "
+      "table, its 26 precomputed neighbour hashes, its place for the duplicate check). "
+      "Section 4.5 (tables stream, bandwidth, bandwidth_passes, bandwidth_thesis; docs/performance/sph-bandwidth.md): "
+      "bytes per particle per step from our data layout in two bounds, \"every access\" (each load and store, a "
+      "neighbour's data once per candidate or pair: the thesis's own way of counting, right for an SPE without a "
+      "cache) and \"streamed\" (each array once per pass, neighbours' data from cache: the least a pass moves), "
+      "times N times the measured Hz = GB/s needed, against a STREAM triad (3 arrays of {} MiB, best of {}) on "
+      "the same thread count. The thesis's model (674N + 8M + 108N^2/M + 48NG bytes per step) is evaluated at its "
+      "example (50000 particles, 75000 buckets, 30 neighbours, 50 Hz: it says roughly 5 GB/s) and at Table 5.3's "
+      "simulated 8-SPE rates, against the Cell's practical 15-20 GB/s it cites. Decimal GB (10^9 B).",
       a.settle, seeds::kThesisSettleSteps, 100 * seeds::kThesisPpcForceShareBelow,
-      100 * seeds::kThesisSpeHashSearchShare);
+      100 * seeds::kThesisSpeHashSearchShare, k_text(k_fig), triad_n * 8 >> 20, triad_reps);
 
   // Plots: cost per particle (Figures 5.3, 5.5), efficiency (Figure 5.7), subtasks (Figure 5.2).
   const auto label = [&](const std::string& st) { return names.size() > 1 ? " " + st : std::string(); };
@@ -500,6 +847,15 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
              {"share_structure", "structure build"}, {"share_search_density", "search + density"}, {"share_forces", "forces"},
              {"share_integrate", "integrate + collide"}, {"share_other", "other"}})
       shares.series.push_back({"", col, name, {{"neighbours", k_eff}, {"threads", "1"}, {"strategy", st}}, ""});
+    shares.series.push_back({"fig56", "share_hash_search", "hashing + search, together (Figure 5.6's sum)",
+                             {{"neighbours", k_eff}, {"strategy", st}}, ""});
+    PlotPoints thesis56{fmt::format("thesis 1 SPE: hashing + search {:.0f} % (Figure 5.6 text, simulated)",
+                                    100 * seeds::kThesisSpeHashSearchShare), {}, {}};
+    for (std::size_t n : a.sizes) {
+      thesis56.x.push_back(double(n));
+      thesis56.y.push_back(100 * seeds::kThesisSpeHashSearchShare);
+    }
+    shares.points = {thesis56};
     share_panels.push_back(shares);
   }
   PlotPanel settling;
@@ -510,7 +866,30 @@ int run_sph_table(SphTableArgs a, const CommonArgs& common) {
     settling.series.push_back({"settling", "mean_neighbours", fmt::format("k={},", k_text(k)),
                                {{"neighbours", k_text(k)}}, "particles"});
   r.plots.push_back({"sph-table_settling.png", "SPH random box: neighbours while settling (thesis Figure 5.1)", {settling}});
-  r.plots.push_back({"sph-table_subtasks.png", "SPH random box: subtasks, k=" + k_eff + " (thesis Figure 5.2)", share_panels});
+  r.plots.push_back({"sph-table_subtasks.png",
+                     "SPH random box: subtasks on 1 thread, k=" + k_eff + " (thesis Figures 5.2 and 5.6)", share_panels});
+
+  // Section 4.5: the share of this machine's triad bandwidth each strategy's step rate needs.
+  PlotPanel bw;
+  bw.x = "particles";
+  bw.xlabel = "particles N";
+  bw.ylabel = fmt::format("% of the triad bandwidth, {} threads, k={}", all, k_text(k_fig));
+  bw.logx = bw.logy = true;
+  for (const auto& st : names) {
+    bw.series.push_back({"bandwidth", "fraction_access_pct", fmt::format("swirl {} every access", st),
+                         {{"strategy", st}, {"threads", fmt::format("{}", all)}}, ""});
+    bw.series.push_back({"bandwidth", "fraction_streamed_pct", fmt::format("swirl {} streamed", st),
+                         {{"strategy", st}, {"threads", fmt::format("{}", all)}}, ""});
+  }
+  PlotPoints cell_bw{"thesis Cell 8 SPEs, its model at Table 5.3's rates, of 15 GB/s", {}, {}};
+  for (const auto& row : seeds::kThesisSph) {
+    const double rn = double(row.particles);
+    cell_bw.x.push_back(rn);
+    cell_bw.y.push_back(100 * seeds::thesis_bandwidth_bytes(rn, double(sph::default_bucket_count(row.particles)), 25) *
+                        row.cell_8spe_hz / 1e9 / seeds::kThesisCellPracticalGBsLow);
+  }
+  bw.points = {cell_bw};
+  r.plots.push_back({"sph-table_bandwidth.png", "SPH random box: memory traffic against bandwidth (thesis section 4.5)", {bw}});
   return publish(r, common);
 }
 

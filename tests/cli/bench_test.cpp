@@ -115,7 +115,7 @@ TEST_F(BenchCli, SphTableQuick) {
               "us_per_particle_step", "share_structure", "share_table", "share_search_density", "share_forces", "share_integrate",
               "share_other", "speedup", "efficiency", "thesis_ppc970_hz", "thesis_cell_1spe_hz", "thesis_cell_8spe_hz",
               "thesis_cell_8spe_efficiency", "sorts_per_step", "kf_structure", "kf_density", "kf_forces", "kf_integrate",
-              "kf_step", "kf_noise"},
+              "kf_step", "kf_noise", "share_neighbour_hashes"},
              8,
              {"particles", "measured_neighbours", "threads", "hz", "us_per_particle_step", "share_structure",
               "share_search_density", "share_forces", "share_integrate", "share_other", "speedup", "efficiency"});
@@ -139,8 +139,29 @@ TEST_F(BenchCli, SphTableQuick) {
   // Figure 5.4: the thesis's ratio where it has a row (N = 1000, k = 25); ours needs hash and grid runs.
   expect_csv(d / "sph-table_fig54.csv", {"particles", "neighbours", "hash_over_grid", "thesis_spe_over_ppc"}, 1,
              {"thesis_spe_over_ppc"});
+  // Figure 5.6: one 1-thread row per size at the last k; section 4.5: the triad on each thread count, the
+  // model on every row at the last k, pass by pass (6 passes + total), and the thesis's own figures (example + 9 rows).
+  expect_csv(d / "sph-table_fig56.csv",
+             {"particles", "neighbours", "strategy", "source", "share_hashing", "share_table", "share_neighbour_hashes",
+              "share_search_density", "share_hash_search", "share_forces", "share_rest", "thesis_spe_hash_search"},
+             2, {"share_hashing", "share_search_density", "share_hash_search", "thesis_spe_hash_search"});
+  expect_csv(d / "sph-table_stream.csv",
+             {"threads", "array_mib", "repetitions", "triad_gbs", "thesis_cell_practical_gbs"}, 2, {"triad_gbs"});
+  expect_csv(d / "sph-table_bandwidth.csv",
+             {"particles", "neighbours", "strategy", "threads", "hz", "measured_neighbours", "candidates",
+              "bytes_access", "bytes_streamed", "gbs_access", "gbs_streamed", "triad_gbs", "fraction_access_pct",
+              "fraction_streamed_pct", "thesis_bytes", "thesis_8spe_gbs", "thesis_8spe_fraction_pct"},
+             4, {"candidates", "bytes_access", "bytes_streamed", "gbs_access", "fraction_access_pct"});
+  expect_csv(d / "sph-table_bandwidth_passes.csv",
+             {"pass", "thesis", "hash_access", "hash_streamed", "hash_precomputed_access", "grid_access",
+              "grid_streamed"},
+             7, {"thesis", "grid_access", "grid_streamed"});
+  expect_csv(d / "sph-table_bandwidth_thesis.csv",
+             {"case", "particles", "buckets", "neighbours", "hz", "bytes_per_particle", "gbs", "gbs_stated",
+              "aligned_pct", "fraction_pct"},
+             10, {"bytes_per_particle", "gbs", "aligned_pct"});
   for (const char* png : {"sph-table_cost.png", "sph-table_efficiency.png", "sph-table_subtasks.png",
-                          "sph-table_settling.png"})
+                          "sph-table_settling.png", "sph-table_bandwidth.png"})
     expect_png(d / png);
 }
 
