@@ -369,18 +369,18 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "sph.hash.duplicate_check", .section = "sph",
                      .doc = "the thesis's cell-relation check against duplicate interactions"},
             in_sph(&sph::SphParameters::duplicate_check)));
-  add(field(SceneKey{.key = "sph.hash.check_placement", .section = "sph",
+  add(field(SceneKey{.key = "sph.hash.check_placement", .section = "sph", .noun = "check placement",
                      .doc = "where the duplicate check runs: `\"before_distance\"` (ours: a colliding entry costs no "
                             "distance test) or `\"after_distance\"` (the thesis's place, section 4.2.3: the cells of "
                             "the pairs within h); the same pairs in the same order either way",
                      .hashed = false},
             in_sph(&sph::SphParameters::check_placement)));
-  add(field(SceneKey{.key = "sph.hash.table_build", .section = "sph",
+  add(field(SceneKey{.key = "sph.hash.table_build", .section = "sph", .noun = "table build",
                      .doc = "hash: the table's counting sort on every thread (`\"parallel\"`) or on one "
                             "(`\"serial\"`, as the thesis's PPE built it: its serial portion); the same table",
                      .hashed = false},
             in_sph(&sph::SphParameters::table_build)));
-  add(field(SceneKey{.key = "sph.hash.neighbour_hashes", .section = "sph",
+  add(field(SceneKey{.key = "sph.hash.neighbour_hashes", .section = "sph", .noun = "neighbour hashing",
                      .doc = "hash: the buckets of the 26 cells around a particle's, hashed by the search as it scans "
                             "them (`\"on_the_fly\"`) or precomputed per particle while the table is built "
                             "(`\"precomputed\"`, the thesis's section 4.2.3); the same pairs in the same order",
