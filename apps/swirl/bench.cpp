@@ -55,6 +55,10 @@ CLI::App* add_suite(CLI::App* bench, Commands& commands, const std::string& name
   return cmd;
 }
 
+constexpr const char* kSchemesHelp =
+    "subdomain, subtree, global; subdomain+paper, subtree+paper: the paper's split (subtree+parts, subtree+clusters: "
+    "one of its two rules)";
+
 }  // namespace
 
 void add_bench_commands(CLI::App& app, Commands& commands) {
@@ -93,7 +97,7 @@ void add_bench_commands(CLI::App& app, Commands& commands) {
   c = add_suite(bench_cmd, commands, "bh-table", "Barnes-Hut: the paper's Table 2 and Figures 9-13", common,
                 [bt, common] { return bench::run_bh_table(*bt, *common); });
   c->add_option("--sizes", bt->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
-  c->add_option("--schemes", bt->schemes, "subdomain,subtree,global")->delimiter(',');
+  c->add_option("--schemes", bt->schemes, kSchemesHelp)->delimiter(',');
   c->add_option("--iterations", bt->iterations, "Iterations")->check(whole_number(1, kMaxCount));
   c->add_option("--opening", bt->opening, "Opening criterion lambda")->check(number_in(0.0, 1.0));
 
@@ -102,14 +106,14 @@ void add_bench_commands(CLI::App& app, Commands& commands) {
                 common, [bl, common] { return bench::run_bh_lambda(*bl, *common); });
   c->add_option("--sizes", bl->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
   c->add_option("--lambdas", bl->openings, "Opening criteria")->delimiter(',')->check(number_in(0.0, 1.0));
-  c->add_option("--schemes", bl->schemes, "subdomain,subtree,global")->delimiter(',');
+  c->add_option("--schemes", bl->schemes, kSchemesHelp)->delimiter(',');
   c->add_option("--iterations", bl->iterations, "Iterations")->check(whole_number(1, kMaxCount));
 
   auto bp = std::make_shared<bench::BhPhasesArgs>();
   c = add_suite(bench_cmd, commands, "bh-phases", "Barnes-Hut: time per phase beside the paper's Table 1", common,
                 [bp, common] { return bench::run_bh_phases(*bp, *common); });
   c->add_option("--sizes", bp->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
-  c->add_option("--schemes", bp->schemes, "subdomain,subtree,global")->delimiter(',');
+  c->add_option("--schemes", bp->schemes, kSchemesHelp)->delimiter(',');
   c->add_option("--iterations", bp->iterations, "Iterations")->check(whole_number(1, kMaxCount));
   c->add_option("--opening", bp->opening, "Opening criterion lambda")->check(number_in(0.0, 1.0));
 

@@ -129,7 +129,7 @@ struct HashStatsArgs {
 };
 struct BhTableArgs {
   std::vector<std::size_t> sizes{1024, 2048, 4096, 8192, 16384, 32768};
-  std::vector<std::string> schemes{"subdomain", "subtree", "global"};
+  std::vector<std::string> schemes{"subdomain", "subdomain+paper", "subtree", "subtree+paper", "global"};
   int iterations = 50;
   double opening = 0.5;
 };

@@ -112,7 +112,6 @@ void BarnesHut<Real>::evaluate_linear(std::size_t n, GravityField<Real>& out, st
   stats_.mean_nodes_visited = n ? double(counts.nodes) / double(n) : 0.0;
   stats_.mean_interactions = n ? double(counts.multipoles + counts.pairs) / double(n) : 0.0;
   work_.assign(1, counts.nodes);
-  previous_work_ = work_;
 }
 
 template <class Real>
@@ -126,30 +125,16 @@ void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real
   if (uses_linear_tree()) return compute_linear(p, out, block_size);
 
   const auto t0 = Clock::now();
-  std::vector<std::uint64_t> weights;
+  weights_.clear();
   switch (settings_.scheme) {
     case Scheme::Subdomain:
       build_subdomains(p);
-      // Section 4.1.1: the first evaluation deals equal shares of particles,
-      // later ones the nodes each sub-domain's tree explored the step before.
-      if (previous_work_.size() == sources_.size()) {
-        weights = previous_work_;
-      } else {
-        for (const auto& [b, e] : runs_) weights.push_back(e - b);
-      }
+      subdomain_weights();
       break;
     case Scheme::Subtree:
       build_global_tree(p);
       cut_units();
-      // Section 4.2.1: units are dealt by their number of nodes.
-      for (const Source& s : sources_) {
-        std::uint64_t nodes = 0;
-        for (std::uint32_t k = s.entries_begin; k < s.entries_end; ++k) {
-          const std::uint32_t e = entries_[k];
-          nodes += trees_[0].nodes()[e].end - e;
-        }
-        weights.push_back(nodes);
-      }
+      unit_weights();
       break;
     case Scheme::Global:
       build_global_tree(p);
@@ -166,13 +151,48 @@ void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real
     walk_global(p, out, block_size);
     stats_.trees = 1;
   } else {
-    walk_sources(p, out, block_size, weights);
+    walk_sources(p, out, block_size, weights_);
     stats_.trees = sources_.size();
   }
   stats_.force_seconds = seconds_since(t1);
   const std::uint64_t visited = std::accumulate(work_.begin(), work_.end(), std::uint64_t(0));
   stats_.mean_nodes_visited = n ? double(visited) / double(n) : 0.0;
-  previous_work_ = work_;
+  if (settings_.scheme == Scheme::Subdomain) {
+    // Section 4.1.1's metric for the next evaluation, kept by sub-domain.
+    measured_.clear();
+    for (std::size_t t = 0; t < ids_.size(); ++t) measured_.emplace_back(ids_[t], work_[t]);
+    std::sort(measured_.begin(), measured_.end());
+    measured_work_per_particle_ = stats_.mean_nodes_visited;
+  }
+}
+
+template <class Real>
+void BarnesHut<Real>::subdomain_weights() {
+  // Section 4.1.1: the first evaluation deals equal shares of particles, later
+  // ones the nodes each sub-domain's tree explored the evaluation before. A
+  // sub-domain is found by its cells, so a weight always belongs to the
+  // sub-domain it was measured on; a new one is estimated from its particles.
+  for (std::size_t t = 0; t < runs_.size(); ++t) {
+    const std::uint64_t particles = runs_[t].second - runs_[t].first;
+    const auto found = std::lower_bound(measured_.begin(), measured_.end(), ids_[t],
+                                        [](const auto& m, const SubdomainId& id) { return m.first < id; });
+    if (found != measured_.end() && found->first == ids_[t]) weights_.push_back(found->second);
+    else if (!measured_.empty()) weights_.push_back(std::uint64_t(std::llround(measured_work_per_particle_ * double(particles))));
+    else weights_.push_back(particles);
+  }
+}
+
+template <class Real>
+void BarnesHut<Real>::unit_weights() {
+  // Section 4.2.1: units are dealt by their number of nodes.
+  for (const Source& s : sources_) {
+    std::uint64_t nodes = 0;
+    for (std::uint32_t k = s.entries_begin; k < s.entries_end; ++k) {
+      const std::uint32_t e = entries_[k];
+      nodes += trees_[0].nodes()[e].end - e;
+    }
+    weights_.push_back(nodes);
+  }
 }
 
 template <class Real>
@@ -202,43 +222,10 @@ void BarnesHut<Real>::build_subdomains(const ParticleSet<Real>& p) {
   order_.resize(n);
   for (std::size_t k = 0; k < n; ++k) order_[k] = keys_[k].second;
 
-  // Sub-domains: Morton cells, taken in Morton order, packed greedily into
-  // runs of ≤ S particles; a cell with more than S particles is split into its
-  // eight children, and one that cannot be split (the finest level) is cut
-  // into equal runs. Runs are contiguous in order_.
-  const std::size_t S = settings_.subdomain_size;
   runs_.clear();
-  std::size_t run_begin = 0;
-  std::vector<std::tuple<int, std::size_t, std::size_t>> cells_to_visit{{0, 0, n}};
-  while (!cells_to_visit.empty()) {
-    const auto [level, b, e] = cells_to_visit.back();
-    cells_to_visit.pop_back();
-    if (e - b <= S) {
-      if (e - run_begin > S) {
-        runs_.emplace_back(run_begin, b);
-        run_begin = b;
-      }
-      continue;
-    }
-    if (level == kMortonLevels) {
-      if (run_begin < b) runs_.emplace_back(run_begin, b);
-      const std::size_t parts = (e - b + S - 1) / S;
-      for (std::size_t q = 0; q < parts; ++q) runs_.emplace_back(b + q * (e - b) / parts, b + (q + 1) * (e - b) / parts);
-      run_begin = e;
-      continue;
-    }
-    const int shift = 3 * (kMortonLevels - 1 - level);
-    std::array<std::size_t, 9> bound{};
-    bound[0] = b;
-    bound[8] = e;
-    for (std::uint64_t c = 1; c < 8; ++c)
-      bound[c] = std::size_t(std::partition_point(keys_.begin() + std::ptrdiff_t(b), keys_.begin() + std::ptrdiff_t(e),
-                                                  [&](const auto& k) { return ((k.first >> shift) & 7u) < c; }) -
-                             keys_.begin());
-    for (std::size_t c = 8; c-- > 0;)
-      if (bound[c] < bound[c + 1]) cells_to_visit.emplace_back(level + 1, bound[c], bound[c + 1]);
-  }
-  if (run_begin < n) runs_.emplace_back(run_begin, n);
+  ids_.clear();
+  if (settings_.subdomain_split == SubdomainSplit::Paper) split_paper_cells();
+  else split_adaptive();
 
   // Section 4.1.2: one local tree per sub-domain, built independently.
   const std::size_t trees = runs_.size();
@@ -259,6 +246,116 @@ void BarnesHut<Real>::build_subdomains(const ParticleSet<Real>& p) {
   });
 }
 
+// Packs whole Morton cells, visited in Morton order, into runs of ≤ S
+// particles (keys_ sorted): add(begin, end, key_begin, key_end) offers the next
+// cell; cut(...) closes the run and cuts a cell over S into equal runs.
+template <class Real>
+class BarnesHut<Real>::RunPacker {
+ public:
+  RunPacker(std::size_t size, std::vector<std::pair<std::size_t, std::size_t>>& runs, std::vector<SubdomainId>& ids)
+      : size_(size), runs_(runs), ids_(ids) {}
+  void add(std::size_t b, std::size_t e, std::uint64_t key_begin, std::uint64_t key_end) {
+    if (e - begin_ > size_) close();
+    if (begin_ == end_) {
+      begin_ = b;
+      key_begin_ = key_begin;
+    }
+    end_ = e;
+    key_end_ = key_end;
+  }
+  void cut(std::size_t b, std::size_t e, std::uint64_t key_begin, std::uint64_t key_end) {
+    close();
+    const std::size_t parts = (e - b + size_ - 1) / size_;
+    for (std::size_t q = 0; q < parts; ++q) {
+      runs_.emplace_back(b + q * (e - b) / parts, b + (q + 1) * (e - b) / parts);
+      ids_.push_back({key_begin, key_end, std::uint32_t(q), std::uint32_t(parts)});
+    }
+    begin_ = end_ = e;
+  }
+  void close() {
+    if (begin_ < end_) {
+      runs_.emplace_back(begin_, end_);
+      ids_.push_back({key_begin_, key_end_, 0, 1});
+    }
+    begin_ = end_;
+  }
+
+ private:
+  std::size_t size_;
+  std::vector<std::pair<std::size_t, std::size_t>>& runs_;
+  std::vector<SubdomainId>& ids_;
+  std::size_t begin_ = 0, end_ = 0;  // the open run
+  std::uint64_t key_begin_ = 0, key_end_ = 0;
+};
+
+namespace {
+// The key range [begin, end) of the level-`level` Morton cell holding `key`.
+std::pair<std::uint64_t, std::uint64_t> cell_keys(std::uint64_t key, int level) {
+  const int shift = 3 * (kMortonLevels - level);  // ≤ 63
+  const std::uint64_t begin = (key >> shift) << shift;
+  return {begin, begin + (std::uint64_t(1) << shift)};
+}
+}  // namespace
+
+template <class Real>
+void BarnesHut<Real>::split_adaptive() {
+  // Morton cells, taken in Morton order, packed greedily into runs of ≤ S
+  // particles; a cell with more than S particles is split into its eight
+  // children, and one that cannot be split (the finest level) is cut into
+  // equal runs.
+  const std::size_t n = keys_.size(), S = settings_.subdomain_size;
+  if (n == 0) return;
+  RunPacker pack(S, runs_, ids_);
+  std::vector<std::tuple<int, std::size_t, std::size_t>> cells_to_visit{{0, 0, n}};
+  while (!cells_to_visit.empty()) {
+    const auto [level, b, e] = cells_to_visit.back();
+    cells_to_visit.pop_back();
+    const auto [key_begin, key_end] = cell_keys(keys_[b].first, level);
+    if (e - b <= S) {
+      pack.add(b, e, key_begin, key_end);
+      continue;
+    }
+    if (level == kMortonLevels) {
+      pack.cut(b, e, key_begin, key_end);
+      continue;
+    }
+    const int shift = 3 * (kMortonLevels - 1 - level);
+    std::array<std::size_t, 9> bound{};
+    bound[0] = b;
+    bound[8] = e;
+    for (std::uint64_t c = 1; c < 8; ++c)
+      bound[c] = std::size_t(std::partition_point(keys_.begin() + std::ptrdiff_t(b), keys_.begin() + std::ptrdiff_t(e),
+                                                  [&](const auto& k) { return ((k.first >> shift) & 7u) < c; }) -
+                             keys_.begin());
+    for (std::size_t c = 8; c-- > 0;)
+      if (bound[c] < bound[c + 1]) cells_to_visit.emplace_back(level + 1, bound[c], bound[c + 1]);
+  }
+  pack.close();
+}
+
+template <class Real>
+void BarnesHut<Real>::split_paper_cells() {
+  // Section 5: "the workspace is initially divided into 512 sub-domains", the
+  // level-3 Morton cells of the bounding cube, and sub-domains of at most 208
+  // particles are made of them. Ours: the occupied cells in Morton order,
+  // packed greedily; the paper does not say what it did with a cell over the
+  // size (the centre of a Plummer sphere of 32768 holds thousands): cut into
+  // equal runs in Morton order.
+  constexpr int kPaperLevel = 3;  // 8³ = 512 cells
+  const std::size_t n = keys_.size();
+  RunPacker pack(settings_.subdomain_size, runs_, ids_);
+  for (std::size_t b = 0; b < n;) {
+    const auto [key_begin, key_end] = cell_keys(keys_[b].first, kPaperLevel);
+    const auto e = std::size_t(std::partition_point(keys_.begin() + std::ptrdiff_t(b), keys_.end(),
+                                                    [&](const auto& k) { return k.first < key_end; }) -
+                               keys_.begin());
+    if (e - b <= settings_.subdomain_size) pack.add(b, e, key_begin, key_end);
+    else pack.cut(b, e, key_begin, key_end);
+    b = e;
+  }
+  pack.close();
+}
+
 template <class Real>
 void BarnesHut<Real>::build_global_tree(const ParticleSet<Real>& p) {
   const std::size_t n = p.size();
@@ -277,9 +374,13 @@ template <class Real>
 void BarnesHut<Real>::cut_units() {
   // Section 4.2.1: whole sub-trees packed greedily in depth-first order into
   // units of ≤ U nodes, keeping clusters together first; a node with more than
-  // U nodes below it cannot lie in one unit: it straddles, and is opened.
+  // U nodes below it cannot lie in one unit: it straddles units. U is ours
+  // (subtree_nodes) or the paper's share of the node total.
   const auto nodes = trees_[0].nodes();
-  const std::size_t U = settings_.subtree_nodes;
+  const std::size_t U = settings_.subtree_split == SubtreeSplit::Parts
+                            ? std::max<std::size_t>(1, (nodes.size() + settings_.subtree_parts - 1) / settings_.subtree_parts)
+                            : settings_.subtree_nodes;
+  unit_nodes_ = U;
   sources_.clear();
   entries_.clear();
   std::size_t fill = 0, unit_begin = 0;
@@ -304,6 +405,21 @@ void BarnesHut<Real>::cut_units() {
     }
   }
   if (unit_begin < entries_.size()) sources_.push_back({0, std::uint32_t(unit_begin), std::uint32_t(entries_.size())});
+
+  // The units below every entry and straddling node. Units are runs of
+  // entries in depth-first order, so those below a node are a range; a
+  // straddling node's children are entries or straddle, and come after it.
+  unit_first_.assign(nodes.size(), 0);
+  unit_last_.assign(nodes.size(), 0);
+  for (std::uint32_t u = 0; u < sources_.size(); ++u)
+    for (std::uint32_t k = sources_[u].entries_begin; k < sources_[u].entries_end; ++k)
+      unit_first_[entries_[k]] = unit_last_[entries_[k]] = u;
+  for (std::size_t node = nodes.size(); node-- > 0;) {
+    if (nodes[node].end - node <= U) continue;
+    const std::uint32_t first_child = std::uint32_t(node + 1);
+    unit_first_[node] = unit_first_[first_child];
+    for (std::uint32_t c = first_child; c < nodes[node].end; c = nodes[c].end) unit_last_[node] = unit_last_[c];
+  }
 }
 
 template <class Real>
@@ -341,19 +457,58 @@ std::uint64_t BarnesHut<Real>::walk_source(const ParticleSet<Real>& p, std::size
                                                source.entries_end - source.entries_begin);
   const Real lambda2 = Real(settings_.opening * settings_.opening);
   const Real eps2 = Real(settings_.softening * settings_.softening);
-  std::vector<std::uint32_t> visit;
+  // The paper's replicated upper levels, when the tree has any (a one-unit
+  // tree's root is the unit's only entry).
+  const bool upper = settings_.scheme == Scheme::Subtree && settings_.upper_nodes == UpperNodes::Clusters &&
+                     tree.nodes().size() > unit_nodes_;
+  std::vector<std::uint32_t> visit, walked;
   std::uint64_t count = 0;
   for (const std::uint32_t i : order_) {
     const std::uint32_t leaf = home_tree_[i] == source.tree ? home_leaf_[i] : Octree<Real>::npos;
     const typename Octree<Real>::Target target{p.position.x[i], p.position.y[i], p.position.z[i], i, leaf};
     Accumulator<Real> acc;
-    count += tree.walk(entries, target, lambda2, eps2, acc, visit);
+    if (upper) count += walk_upper(std::uint32_t(s), target, lambda2, eps2, acc, visit, walked);
+    else count += tree.walk(entries, target, lambda2, eps2, acc, visit);
     into.acceleration.x[i] = acc.ax;
     into.acceleration.y[i] = acc.ay;
     into.acceleration.z[i] = acc.az;
     into.potential[i] = acc.phi;
   }
   return count;
+}
+
+template <class Real>
+std::uint64_t BarnesHut<Real>::walk_upper(std::uint32_t unit, const typename Octree<Real>::Target& target,
+                                          Real lambda2, Real eps2, Accumulator<Real>& acc,
+                                          std::vector<std::uint32_t>& visit, std::vector<std::uint32_t>& entries) const {
+  // From the root down the straddling nodes above this unit's entries: a node
+  // the λ rule accepts is one cluster, added by the unit holding its first
+  // descendant only (the other units' share of its mass is in it); one it
+  // opens leads to the children holding this unit's entries. The entries the
+  // walk reaches are then walked as in the global tree, in the order reached.
+  const Octree<Real>& tree = trees_[0];
+  const auto nodes = tree.nodes();
+  std::uint64_t count = 0;
+  entries.clear();
+  visit.assign(1, 0);
+  while (!visit.empty()) {
+    const std::uint32_t n = visit.back();
+    visit.pop_back();
+    ++count;
+    if (tree.accepts(n, target, lambda2)) {
+      const auto& node = nodes[n];
+      if (unit_first_[n] == unit) acc.add(node.x - target.x, node.y - target.y, node.z - target.z, node.mass, eps2);
+      continue;
+    }
+    const std::size_t first_visit = visit.size();
+    for (std::uint32_t c = n + 1; c < nodes[n].end; c = nodes[c].end) {
+      if (unit < unit_first_[c] || unit > unit_last_[c]) continue;
+      if (nodes[c].end - c > unit_nodes_) visit.push_back(c);
+      else entries.push_back(c);
+    }
+    std::reverse(visit.begin() + std::ptrdiff_t(first_visit), visit.end());  // children in depth-first order
+  }
+  return count + tree.walk(entries, target, lambda2, eps2, acc, visit);
 }
 
 template <class Real>

@@ -16,6 +16,19 @@
 namespace swirl::gravity {
 
 namespace {
+// The paper's tree (the paper's tables measure it; bh-scale measures the linear one).
+GravitySettings paper_tree(Scheme scheme, const SplitRules& splits, double opening, double softening) {
+  GravitySettings g;
+  g.scheme = scheme;
+  g.subdomain_split = splits.subdomain;
+  g.subtree_split = splits.subtree;
+  g.upper_nodes = splits.upper_nodes;
+  g.tree = Tree::Paper;
+  g.opening = opening;
+  g.softening = softening;
+  return g;
+}
+
 // The paper's time step: velocity Verlet (the simulation's stepper,
 // integrate/kick_drift.hpp) around one gravity evaluation; "update" is the
 // stepper's own time (drift, zeroing a, kick).
@@ -45,12 +58,8 @@ class GravityOnly final : public integrate::Forces {
 
 template <class Real>
 BenchResult run(const BenchSettings& b) {
-  GravitySettings g;
+  GravitySettings g = paper_tree(b.scheme, b.splits, b.opening, b.softening);
   g.method = b.method;
-  g.scheme = b.scheme;
-  g.tree = Tree::Paper;  // the paper's tables measure the paper's tree (bh-scale measures the linear one)
-  g.opening = b.opening;
-  g.softening = b.softening;
   GravityForce<Real> gravity(g);
   ParticleSet<Real> p = plummer<Real>(b.n, b.seed);
   constexpr std::size_t block = 1024;
@@ -113,12 +122,7 @@ std::vector<ForceError> errors_of(const BenchSettings& b, const std::vector<Forc
   out.reserve(cases.size());
   std::vector<double> e(p.size());
   for (const ForceErrorCase& c : cases) {
-    GravitySettings g;
-    g.scheme = c.scheme;
-    g.tree = Tree::Paper;
-    g.opening = c.opening;
-    g.softening = b.softening;
-    BarnesHut<Real> tree(g);
+    BarnesHut<Real> tree(paper_tree(c.scheme, c.splits, c.opening, b.softening));
     GravityField<Real> field;
     tree.compute(p, field, kBlock);
     parallel::for_blocks("bench_force_error", p.size(), kBlock, [&](std::size_t begin, std::size_t end, std::size_t) {
@@ -160,14 +164,7 @@ ForceError summarize_errors(std::vector<double>& errors) {
 
 std::vector<ForceError> force_errors(const BenchSettings& b, const std::vector<ForceErrorCase>& cases) {
   check(b);
-  for (const ForceErrorCase& c : cases) {
-    GravitySettings g;
-    g.scheme = c.scheme;
-    g.tree = Tree::Paper;
-    g.opening = c.opening;
-    g.softening = b.softening;
-    validate(g);
-  }
+  for (const ForceErrorCase& c : cases) validate(paper_tree(c.scheme, c.splits, c.opening, b.softening));
   const ThreadScope threads(b.threads);
   return b.single_precision ? errors_of<float>(b, cases) : errors_of<double>(b, cases);
 }

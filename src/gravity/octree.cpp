@@ -168,6 +168,35 @@ void Octree<Real>::renumber(const ParticleSet<Real>& p, std::span<const std::uin
   }
 }
 
+template <class Real>
+std::uint32_t Octree<Real>::walk(std::span<const std::uint32_t> entries, const Target& target, Real lambda2,
+                                 Real eps2, Accumulator<Real>& acc, std::vector<std::uint32_t>& visit) const {
+  visit.assign(entries.rbegin(), entries.rend());
+  std::uint32_t visited = 0;
+  while (!visit.empty()) {
+    const std::uint32_t n = visit.back();
+    visit.pop_back();
+    ++visited;
+    const Node& node = nodes_[n];
+    const Real dx = node.x - target.x, dy = node.y - target.y, dz = node.z - target.z;
+    if (node.count == 0) {
+      if (accepts(n, target, lambda2)) {
+        acc.add(dx, dy, dz, node.mass, eps2);
+      } else {
+        for (std::uint32_t c = n + 1; c < node.end; c = nodes_[c].end) visit.push_back(c);
+      }
+    } else if (node.count == 1) {
+      if (n != target.leaf) acc.add(dx, dy, dz, node.mass, eps2);
+    } else {
+      for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+        if (leaf_particle_[k] == target.particle) continue;
+        acc.add(leaf_x_[k] - target.x, leaf_y_[k] - target.y, leaf_z_[k] - target.z, leaf_m_[k], eps2);
+      }
+    }
+  }
+  return visited;
+}
+
 template class Octree<float>;
 template class Octree<double>;
 

@@ -31,7 +31,13 @@ std::string_view to_string(Tree tree) { return name_of(tree, kTreeNames); }
 std::string_view to_string(Multipole multipole) { return name_of(multipole, kMultipoleNames); }
 std::string_view to_string(Criterion criterion) { return name_of(criterion, kCriterionNames); }
 std::string_view to_string(Walk walk) { return name_of(walk, kWalkNames); }
+std::string_view to_string(SubdomainSplit split) { return name_of(split, kSubdomainSplitNames); }
+std::string_view to_string(SubtreeSplit split) { return name_of(split, kSubtreeSplitNames); }
+std::string_view to_string(UpperNodes upper) { return name_of(upper, kUpperNodesNames); }
 Walk parse_walk(std::string_view name) { return parse("walk", name, kWalkNames); }
+SubdomainSplit parse_subdomain_split(std::string_view name) { return parse("subdomain split", name, kSubdomainSplitNames); }
+SubtreeSplit parse_subtree_split(std::string_view name) { return parse("subtree split", name, kSubtreeSplitNames); }
+UpperNodes parse_upper_nodes(std::string_view name) { return parse("upper-node rule", name, kUpperNodesNames); }
 Tree parse_tree(std::string_view name) { return parse("tree", name, kTreeNames); }
 Multipole parse_multipole(std::string_view name) { return parse("multipole", name, kMultipoleNames); }
 Criterion parse_criterion(std::string_view name) { return parse("opening criterion", name, kCriterionNames); }
@@ -47,6 +53,7 @@ void validate(const GravitySettings& s) {
     throw std::invalid_argument(fmt::format("gravity softening epsilon = {} must be finite and >= 0", s.softening));
   if (s.subdomain_size < 1) throw std::invalid_argument("gravity subdomain_size must be at least 1 particle");
   if (s.subtree_nodes < 1) throw std::invalid_argument("gravity subtree_nodes must be at least 1 node");
+  if (s.subtree_parts < 1) throw std::invalid_argument("gravity subtree_parts must be at least 1 part");
   if (s.bucket_size < 1) throw std::invalid_argument("gravity bucket_size must be at least 1 particle");
   if (s.group_size < 1) throw std::invalid_argument("gravity group_size must be at least 1 particle");
 }

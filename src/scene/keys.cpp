@@ -53,6 +53,15 @@ constexpr std::span<const EnumName<gravity::Tree>> names_of(gravity::Tree) { ret
 constexpr std::span<const EnumName<gravity::Multipole>> names_of(gravity::Multipole) { return gravity::kMultipoleNames; }
 constexpr std::span<const EnumName<gravity::Criterion>> names_of(gravity::Criterion) { return gravity::kCriterionNames; }
 constexpr std::span<const EnumName<gravity::Walk>> names_of(gravity::Walk) { return gravity::kWalkNames; }
+constexpr std::span<const EnumName<gravity::SubdomainSplit>> names_of(gravity::SubdomainSplit) {
+  return gravity::kSubdomainSplitNames;
+}
+constexpr std::span<const EnumName<gravity::SubtreeSplit>> names_of(gravity::SubtreeSplit) {
+  return gravity::kSubtreeSplitNames;
+}
+constexpr std::span<const EnumName<gravity::UpperNodes>> names_of(gravity::UpperNodes) {
+  return gravity::kUpperNodesNames;
+}
 
 template <class T>
 concept NamedEnum = std::is_enum_v<T> && requires(T v) { names_of(v); };
@@ -417,6 +426,29 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "nbody.subtree_nodes", .section = "nbody", .unit = "nodes", .range = kAtLeastOne,
                      .doc = "nodes per unit (subtree)"},
             in_nbody(&GravitySettings::subtree_nodes)));
+  // Keys added after checkpoints existed: the old behaviour's value stays out of the scene hash.
+  add(field(SceneKey{.key = "nbody.subdomain_split", .section = "nbody", .noun = "subdomain split",
+                     .doc = "subdomain: `\"adaptive\"` (Morton cells split from the root while over `subdomain_size`; "
+                            "ours) or `\"paper\"` (the paper's fixed 512 cells packed into sub-domains of ≤ "
+                            "`subdomain_size`); docs/gravity.md",
+                     .unhashed_value = "adaptive"},
+            in_nbody(&GravitySettings::subdomain_split)));
+  add(field(SceneKey{.key = "nbody.subtree_split", .section = "nbody", .noun = "subtree split",
+                     .doc = "subtree: `\"units\"` (units of ≤ `subtree_nodes` nodes; ours) or `\"parts\"` (the paper's: "
+                            "the node total divided by `subtree_parts`)",
+                     .unhashed_value = "units"},
+            in_nbody(&GravitySettings::subtree_split)));
+  add(field(SceneKey{.key = "nbody.subtree_parts", .section = "nbody", .unit = "units", .range = kAtLeastOne,
+                     .doc = "subtree with `subtree_split = \"parts\"`: the paper's number of SPEs (a scene value, not the "
+                            "thread count, so that results do not depend on the threads)",
+                     .unhashed_value = "8"},
+            in_nbody(&GravitySettings::subtree_parts)));
+  add(field(SceneKey{.key = "nbody.upper_nodes", .section = "nbody", .noun = "upper-node rule",
+                     .doc = "subtree: the nodes above the units are `\"opened\"` always (ours) or used as `\"clusters\"` "
+                            "by every unit, counted by one (the paper's replicated upper levels: the global walk's "
+                            "field)",
+                     .unhashed_value = "opened"},
+            in_nbody(&GravitySettings::upper_nodes)));
   add(field(SceneKey{.key = "nbody.tree", .section = "nbody", .noun = "tree",
                      .doc = "`\"linear\"` (the octree from sorted Morton keys) or `\"paper\"` (the paper's "
                             "insertion-built tree); `\"linear\"` needs `scheme = \"global\"`",

@@ -607,7 +607,6 @@ std::string read_file(const std::filesystem::path& file, const std::string& /*na
   }
 }
 
-
 // The canonical text scene_hash() hashes: every declared key the scene has a
 // value for, in declaration order, as a dotted TOML key, then each source as a
 // [[particles]] table of its kind's keys; numbers with 17 significant digits
@@ -617,7 +616,10 @@ std::string canonical_text(const Scene& s) {
   for (const auto& spec : scene_keys())
     if (const auto value = spec.hashed ? spec.get(s) : std::nullopt) {
       const std::string text = value_text(*value, true);
-      if (!spec.unhashed_value.empty() && text == spec.unhashed_value) continue;
+      // unhashed_value is spelt as a scene writes it; a name's text here is quoted.
+      const bool old_behaviour = !spec.unhashed_value.empty() &&
+                                 (text == spec.unhashed_value || text == fmt::format("\"{}\"", spec.unhashed_value));
+      if (old_behaviour) continue;
       out += fmt::format("{} = {}\n", spec.key, text);
     }
   for (const auto& source : s.sources) {

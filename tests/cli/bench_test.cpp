@@ -182,12 +182,16 @@ TEST_F(BenchCli, BhTableQuick) {
   const Result r = bench("bh-table");
   ASSERT_EQ(r.status, 0) << r.err;
   const auto d = dir_ / "bh-table";
-  // 2 sizes x 3 schemes x 2 thread counts.
+  // 2 sizes x 5 schemes (ours and the paper's splits) x 2 thread counts.
   expect_csv(d / "bh-table.csv",
              {"particles", "scheme", "threads", "iterations", "seconds", "us_per_particle_iteration", "tree_seconds",
-              "force_seconds", "update_seconds", "nodes_visited", "trees", "speedup", "efficiency", "speedup_serial",
-              "paper_1spe_s", "paper_4spe_s", "paper_8spe_s", "paper_speedup_8spe", "paper_trees"},
-             12, {"seconds", "us_per_particle_iteration", "nodes_visited", "trees", "speedup", "efficiency", "speedup_serial"});
+              "force_seconds", "update_seconds", "nodes_visited", "trees", "speedup", "paper_speedup_p", "efficiency",
+              "speedup_serial", "paper_over_xeon", "paper_1spe_s", "paper_4spe_s", "paper_8spe_s",
+              "paper_speedup_8spe", "paper_trees"},
+             20, {"seconds", "us_per_particle_iteration", "nodes_visited", "trees", "speedup", "efficiency", "speedup_serial"});
+  // The enhanced over the initial scheme, ours and with the paper's splits: 2 sizes x 2 thread counts.
+  expect_csv(d / "bh-table_enhanced_over_initial.csv", {"particles", "threads", "ours", "paper_splits", "paper"}, 4,
+             {"ours", "paper_splits"});
   expect_records(d / "bh-table.json", "bh-table");
   for (const char* png : {"bh-table_cost.png", "bh-table_efficiency.png"}) expect_png(d / png);
 }
@@ -225,6 +229,8 @@ TEST_F(BenchCli, BhPhasesQuick) {
   expect_csv(d / "bh-phases_paper.csv", {"phase", "kind", "n1024", "n2048", "n4096", "n8192", "n16384", "n32768"}, 12,
              {"n1024", "n32768"});
   EXPECT_NE(r.out.find("238.9 ms"), std::string::npos) << "the Table 1 / Table 2 mismatch is stated";
+  // The figures of the paper's text around Table 1 (ours only where the sizes are the paper's).
+  expect_csv(d / "bh-phases_text.csv", {"figure", "particles", "paper_pct", "ours_pct", "ours_is"}, 9, {"paper_pct"});
   expect_records(d / "bh-phases.json", "bh-phases");
 }
 

@@ -65,6 +65,9 @@ TYPED_TEST(ParametersTest, ZeroSizes) {
   s = {};
   s.bucket_size = 0;
   expect_invalid([&] { GravityForce<Real> g(s); }, {"bucket_size"});
+  s = {};
+  s.subtree_parts = 0;
+  expect_invalid([&] { GravityForce<Real> g(s); }, {"subtree_parts"});
 }
 
 TEST(ParametersTest, TreeMultipoleAndCriterionNamesRoundTrip) {
@@ -74,6 +77,11 @@ TEST(ParametersTest, TreeMultipoleAndCriterionNamesRoundTrip) {
   expect_invalid([] { (void)parse_tree("kd"); }, {"tree", "kd", "\"paper\"", "\"linear\""});
   expect_invalid([] { (void)parse_multipole("octupole"); }, {"octupole", "\"monopole\"", "\"quadrupole\""});
   expect_invalid([] { (void)parse_criterion("bmax"); }, {"bmax", "\"paper\"", "\"barnes\""});
+  for (SubdomainSplit v : {SubdomainSplit::Adaptive, SubdomainSplit::Paper})
+    EXPECT_EQ(parse_subdomain_split(to_string(v)), v);
+  for (SubtreeSplit v : {SubtreeSplit::Units, SubtreeSplit::Parts}) EXPECT_EQ(parse_subtree_split(to_string(v)), v);
+  for (UpperNodes v : {UpperNodes::Opened, UpperNodes::Clusters}) EXPECT_EQ(parse_upper_nodes(to_string(v)), v);
+  expect_invalid([] { (void)parse_upper_nodes("shared"); }, {"shared", "\"opened\"", "\"clusters\""});
   // The defaults of the issue: the linear tree, quadrupoles, Barnes' rule.
   const GravitySettings s;
   EXPECT_EQ(s.scheme, Scheme::Global);

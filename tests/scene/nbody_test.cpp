@@ -44,6 +44,8 @@ TEST(NbodyScene, PlummerSceneParsesIntoOpenSpaceInDouble) {
   EXPECT_EQ(s.nbody->softening, 0.02);
   EXPECT_EQ(s.nbody->subdomain_size, 208u);
   EXPECT_EQ(s.nbody->subtree_nodes, 370u);
+  EXPECT_EQ(s.nbody->subtree_split, swirl::gravity::SubtreeSplit::Units);
+  EXPECT_EQ(s.nbody->upper_nodes, swirl::gravity::UpperNodes::Opened);
   EXPECT_FALSE(s.walls);
   EXPECT_EQ(s.precision, Precision::Double);
   EXPECT_EQ(s.gravity, swirl::Vec3d{});
@@ -56,6 +58,21 @@ TEST(NbodyScene, PlummerSceneParsesIntoOpenSpaceInDouble) {
   EXPECT_EQ(make_particles<double>(s).position.x, p.position.x);
   const auto f = make_particles<float>(parse_scene(kPlummer, "g.toml", std::vector<std::string>{"simulation.precision=\"float\""}));
   EXPECT_EQ(f.size(), 1000u);
+}
+
+TEST(NbodyScene, ThePapersSplitsAreSceneKeys) {
+  const Scene s = parse_scene(kPlummer, "g.toml",
+                              std::vector<std::string>{"nbody.subtree_split=\"parts\"", "nbody.subtree_parts=16",
+                                                       "nbody.upper_nodes=\"clusters\"",
+                                                       "nbody.subdomain_split=\"paper\""});
+  EXPECT_EQ(s.nbody->subtree_split, swirl::gravity::SubtreeSplit::Parts);
+  EXPECT_EQ(s.nbody->subtree_parts, 16u);
+  EXPECT_EQ(s.nbody->upper_nodes, swirl::gravity::UpperNodes::Clusters);
+  EXPECT_EQ(s.nbody->subdomain_split, swirl::gravity::SubdomainSplit::Paper);
+  const std::string e = error_of(kPlummer, {"nbody.upper_nodes=\"shared\""});
+  EXPECT_NE(e.find("nbody.upper_nodes"), std::string::npos) << e;
+  EXPECT_NE(e.find("'clusters'"), std::string::npos) << e;
+  EXPECT_NE(error_of(kPlummer, {"nbody.subtree_parts=0"}).find("nbody.subtree_parts"), std::string::npos);
 }
 
 TEST(NbodyScene, ModelsAreMovedByOffsetAndVelocity) {

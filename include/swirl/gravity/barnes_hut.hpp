@@ -6,25 +6,38 @@
 //              octree (linear_octree.hpp, the default: settings.tree) or the
 //              paper's insertion-built tree.
 //   subdomain  (4.1) particles sorted in Morton order of their positions in the
-//              bounding cube, cut into runs of ≤ subdomain_size particles by
-//              packing Morton cells greedily (the paper's 512 cells, grown
-//              adaptively); one local tree per run; every particle walks every
-//              local tree and its force is their sum.
-//   subtree    (4.2) one global tree, cut depth first into units of ≤
-//              subtree_nodes nodes, a unit being whole sub-trees packed in
-//              depth-first order; every particle walks every unit, its force is
-//              the sum over units. The paper copies the upper nodes into every
-//              local tree without saying how their mass avoids being counted
-//              twice; our reading: a node that straddles units (more than
-//              subtree_nodes nodes below it) is always opened, never used as a
-//              cluster, so every mass is counted exactly once.
-// Sub-domains and units depend on the particles and the sizes only, never on
-// the thread count.
+//              bounding cube, cut into sub-domains of ≤ subdomain_size
+//              particles; one local tree per sub-domain; every particle walks
+//              every local tree and its force is their sum. The cut
+//              (settings.subdomain_split): `adaptive` (ours) packs Morton cells
+//              greedily, splitting from the root any cell over the size;
+//              `paper` packs the paper's fixed 8³ = 512 cells the same way and
+//              cuts a cell over the size into equal runs (the paper does not
+//              say what it did with one).
+//   subtree    (4.2) one global tree, cut depth first into units, a unit being
+//              whole sub-trees packed in depth-first order; every particle
+//              walks every unit, its force is the sum over units. Unit size
+//              (settings.subtree_split): ≤ subtree_nodes nodes (ours) or the
+//              paper's node total / subtree_parts. A node with more nodes below
+//              it than a unit holds straddles units; settings.upper_nodes: such
+//              a node is always opened, never a cluster (ours: every mass is
+//              then counted once by construction), or, as the paper's
+//              replicated upper levels, walked by every unit below it and used
+//              as a cluster where the λ rule allows, that cluster counting for
+//              the unit holding the node's first descendant only (the others
+//              skip it: the paper does not say how it avoided counting it
+//              several times; with this rule the sum over units is the global
+//              walk's field).
+// Sub-domains and units depend on the particles and the settings only, never
+// on the thread count.
 //
 // Who computes what: as on the Cell, a thread walks whole trees (units) for all
-// particles, the trees dealt heaviest first to the least loaded thread, by the
-// nodes each sub-domain's tree explored in the previous evaluation (4.1.1) or
-// by node count for units (4.2.1); global hands particle blocks to threads
+// particles, the trees dealt heaviest first to the least loaded thread. The
+// weights: a sub-domain's nodes explored in the previous evaluation (4.1.1),
+// found by what the sub-domain is (its Morton cells) rather than by its index;
+// a sub-domain new this evaluation is weighed by its particles times the last
+// evaluation's nodes per particle, and the first evaluation by particle counts;
+// units by their node count (4.2.1). global hands particle blocks to threads
 // dynamically. Determinism: each tree's contribution is summed per particle in
 // tree order, whatever thread computed it, so results are bit-identical for
 // any thread count (and the balance changes only who computes what).
@@ -33,6 +46,7 @@
 #pragma once
 
 #include <array>
+#include <compare>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -87,6 +101,11 @@ class BarnesHut {
   // Nodes explored by all particles in each tree (unit) in the last
   // evaluation: the load metric of section 4.1.1.
   std::span<const std::uint64_t> work() const { return work_; }
+  // The weights the last evaluation dealt its trees (units) by, in tree order.
+  std::span<const std::uint64_t> balance_weights() const { return weights_; }
+  // Subdomain scheme: each sub-domain's [begin, end) in the Morton order of
+  // the last evaluation (so end − begin particles); empty for other schemes.
+  std::span<const std::pair<std::size_t, std::size_t>> subdomains() const { return runs_; }
 
   // Memory for the per-tree fields of the subdomain and subtree schemes
   // (N × 4 reals per tree in flight; default 64 MiB): the trees are walked
@@ -100,18 +119,34 @@ class BarnesHut {
     std::uint32_t tree;
     std::uint32_t entries_begin, entries_end;  // into entries_
   };
+  // What a sub-domain is, whatever its index: the Morton key range of its
+  // cells, and which of `parts` equal runs of one cell it is (part 0 of 1 for
+  // whole cells).
+  struct SubdomainId {
+    std::uint64_t key_begin, key_end;
+    std::uint32_t part, parts;
+    auto operator<=>(const SubdomainId&) const = default;
+  };
+  class RunPacker;
 
   void compute_impl(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
   void compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
   LinearTreeSettings linear_settings() const;
   void evaluate_linear(std::size_t n, GravityField<Real>& out, std::size_t block_size, double build_seconds);
   void build_subdomains(const ParticleSet<Real>& p);
+  void split_adaptive();
+  void split_paper_cells();
+  void subdomain_weights();
   void build_global_tree(const ParticleSet<Real>& p);
   void cut_units();
+  void unit_weights();
   void walk_global(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
   void walk_sources(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
                     const std::vector<std::uint64_t>& weights);
   std::uint64_t walk_source(const ParticleSet<Real>& p, std::size_t s, GravityField<Real>& into) const;
+  std::uint64_t walk_upper(std::uint32_t unit, const typename Octree<Real>::Target& target, Real lambda2, Real eps2,
+                           Accumulator<Real>& acc, std::vector<std::uint32_t>& visit,
+                           std::vector<std::uint32_t>& entries) const;
 
   GravitySettings settings_;
   GravityStats stats_;
@@ -119,9 +154,17 @@ class BarnesHut {
   std::vector<Source> sources_;
   std::vector<std::uint32_t> entries_;
   std::vector<std::pair<std::size_t, std::size_t>> runs_;  // sub-domains: [begin, end) of order_
+  std::vector<SubdomainId> ids_;                              // each run's identity
+  // The last evaluation's sub-domains by identity (sorted) with their work, and its work per particle.
+  std::vector<std::pair<SubdomainId, std::uint64_t>> measured_;
+  double measured_work_per_particle_ = 0;
+  // Subtree units: the first and last unit below each node (a straddling node
+  // spans several; a unit's entry spans its own), and the unit size.
+  std::vector<std::uint32_t> unit_first_, unit_last_;
+  std::size_t unit_nodes_ = 0;
   std::vector<std::uint32_t> order_;  // particles in walk order (Morton or leaf order)
   std::vector<std::uint32_t> home_tree_, home_leaf_;  // the tree and leaf holding each particle
-  std::vector<std::uint64_t> work_, previous_work_;
+  std::vector<std::uint64_t> work_, weights_;
   std::vector<GravityField<Real>> buffers_;  // one tree's contribution per buffer
   std::size_t buffer_bytes_ = std::size_t(64) << 20;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keys_;

@@ -14,8 +14,17 @@
 
 namespace swirl::gravity {
 
+// How the scheme splits the work: ours (the defaults) or the paper's
+// (settings.hpp: SubdomainSplit, SubtreeSplit, UpperNodes).
+struct SplitRules {
+  SubdomainSplit subdomain = SubdomainSplit::Adaptive;
+  SubtreeSplit subtree = SubtreeSplit::Units;
+  UpperNodes upper_nodes = UpperNodes::Opened;
+};
+
 struct BenchSettings {
   Scheme scheme = Scheme::Global;
+  SplitRules splits{};
   Method method = Method::BarnesHut;
   std::size_t n = 4096;
   double opening = 0.5;          // λ (the paper's default)
@@ -57,6 +66,7 @@ inline BenchResult time_iterations(Scheme scheme, std::size_t n, double opening,
 struct ForceErrorCase {
   Scheme scheme = Scheme::Global;
   double opening = 0.5;  // λ
+  SplitRules splits{};
 };
 
 // Relative force error e_i = |a_tree,i − a_direct,i| / |a_direct,i| over all

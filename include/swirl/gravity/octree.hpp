@@ -72,38 +72,24 @@ class Octree {
   // Deepest level reached (root = 0).
   int depth() const { return depth_; }
 
+  // Section 2's test for an internal node n: used as one particle at target
+  // (size / d < λ as size² < λ²·d², no division, never true for λ = 0), unless
+  // it holds the target (our addition: a particle never feels its own mass).
+  bool accepts(std::uint32_t n, const Target& target, Real lambda2) const {
+    const Node& node = nodes_[n];
+    const Real dx = node.x - target.x, dy = node.y - target.y, dz = node.z - target.z;
+    const bool holds_target = target.leaf - n < node.end - n;  // n ≤ leaf < end, unsigned
+    return node.size * node.size < lambda2 * (dx * dx + dy * dy + dz * dz) && !holds_target;
+  }
+
   // Adds to acc the field at target of every particle below the nodes `entries`
   // (visited in that order), per the header comment; lambda2 = λ², eps2 = ε².
   // `visit` is scratch. Returns the number of nodes taken from the visit list.
+  // One compiled copy for every caller (octree.cpp), so that the same walk
+  // rounds the same way whichever scheme calls it (a one-unit subtree walk is
+  // the global walk, bit for bit).
   std::uint32_t walk(std::span<const std::uint32_t> entries, const Target& target, Real lambda2, Real eps2,
-                     Accumulator<Real>& acc, std::vector<std::uint32_t>& visit) const {
-    visit.assign(entries.rbegin(), entries.rend());
-    std::uint32_t visited = 0;
-    while (!visit.empty()) {
-      const std::uint32_t n = visit.back();
-      visit.pop_back();
-      ++visited;
-      const Node& node = nodes_[n];
-      const Real dx = node.x - target.x, dy = node.y - target.y, dz = node.z - target.z;
-      if (node.count == 0) {
-        const bool holds_target = target.leaf - n < node.end - n;  // n ≤ leaf < end, unsigned
-        // Section 2's criterion size / d < λ as size² < λ²·d²: no division, never true for λ = 0.
-        if (node.size * node.size < lambda2 * (dx * dx + dy * dy + dz * dz) && !holds_target) {
-          acc.add(dx, dy, dz, node.mass, eps2);
-        } else {
-          for (std::uint32_t c = n + 1; c < node.end; c = nodes_[c].end) visit.push_back(c);
-        }
-      } else if (node.count == 1) {
-        if (n != target.leaf) acc.add(dx, dy, dz, node.mass, eps2);
-      } else {
-        for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-          if (leaf_particle_[k] == target.particle) continue;
-          acc.add(leaf_x_[k] - target.x, leaf_y_[k] - target.y, leaf_z_[k] - target.z, leaf_m_[k], eps2);
-        }
-      }
-    }
-    return visited;
-  }
+                     Accumulator<Real>& acc, std::vector<std::uint32_t>& visit) const;
 
  private:
   // A node while particles are being inserted (geometry and moments in double).

@@ -53,6 +53,30 @@ enum class Criterion { Paper, Barnes };
 //   particle  one walk per particle: the group walk's slow twin and reference.
 enum class Walk { Group, Particle };
 
+// How the subdomain scheme cuts the particles into sub-domains (section 4.1, 5):
+//   adaptive  Morton cells from the root, split while a cell holds more than
+//             subdomain_size particles, packed greedily in Morton order (ours);
+//   paper     the paper's fixed split of the bounding cube into 8³ = 512 cells,
+//             packed in Morton order into sub-domains of ≤ subdomain_size
+//             particles; a cell holding more is cut into equal runs.
+enum class SubdomainSplit { Adaptive, Paper };
+
+// How the subtree scheme cuts the global tree into units (section 4.2.1):
+//   units  whole sub-trees packed depth first into units of ≤ subtree_nodes
+//          nodes, independent of the thread count (ours);
+//   parts  the paper's rule: the node total divided by subtree_parts (its
+//          number of SPEs), units of ⌈nodes / parts⌉ nodes at most.
+enum class SubtreeSplit { Units, Parts };
+
+// What a subtree unit does with the nodes above it (those straddling units):
+//   opened    always opened, never used as a cluster (ours: the simplest way to
+//             count every mass once);
+//   clusters  the paper's replicated upper levels: every unit walks them and may
+//             use one as a cluster, which then counts for the unit holding the
+//             node's first descendant only; the others skip it. The sum over
+//             units is then the global walk's field.
+enum class UpperNodes { Opened, Clusters };
+
 // The names scenes, messages and options use: the only place they are spelt.
 inline constexpr std::array<EnumName<Method>, 2> kMethodNames{{{"direct", Method::Direct}, {"barnes_hut", Method::BarnesHut}}};
 inline constexpr std::array<EnumName<Scheme>, 3> kSchemeNames{
@@ -62,6 +86,12 @@ inline constexpr std::array<EnumName<Multipole>, 2> kMultipoleNames{
     {{"monopole", Multipole::Monopole}, {"quadrupole", Multipole::Quadrupole}}};
 inline constexpr std::array<EnumName<Criterion>, 2> kCriterionNames{{{"paper", Criterion::Paper}, {"barnes", Criterion::Barnes}}};
 inline constexpr std::array<EnumName<Walk>, 2> kWalkNames{{{"group", Walk::Group}, {"particle", Walk::Particle}}};
+inline constexpr std::array<EnumName<SubdomainSplit>, 2> kSubdomainSplitNames{
+    {{"adaptive", SubdomainSplit::Adaptive}, {"paper", SubdomainSplit::Paper}}};
+inline constexpr std::array<EnumName<SubtreeSplit>, 2> kSubtreeSplitNames{
+    {{"units", SubtreeSplit::Units}, {"parts", SubtreeSplit::Parts}}};
+inline constexpr std::array<EnumName<UpperNodes>, 2> kUpperNodesNames{
+    {{"opened", UpperNodes::Opened}, {"clusters", UpperNodes::Clusters}}};
 
 std::string_view to_string(Method method);
 std::string_view to_string(Scheme scheme);
@@ -69,6 +99,9 @@ std::string_view to_string(Tree tree);
 std::string_view to_string(Multipole multipole);
 std::string_view to_string(Criterion criterion);
 std::string_view to_string(Walk walk);
+std::string_view to_string(SubdomainSplit split);
+std::string_view to_string(SubtreeSplit split);
+std::string_view to_string(UpperNodes upper);
 // Parse "direct" | "barnes_hut" and "subdomain" | "subtree" | "global"; an
 // unknown name throws std::invalid_argument listing the allowed ones.
 Method parse_method(std::string_view name);
@@ -79,6 +112,10 @@ Multipole parse_multipole(std::string_view name);
 Criterion parse_criterion(std::string_view name);
 // "group" | "particle"; the same errors.
 Walk parse_walk(std::string_view name);
+// "adaptive" | "paper", "units" | "parts", "opened" | "clusters"; the same errors.
+SubdomainSplit parse_subdomain_split(std::string_view name);
+SubtreeSplit parse_subtree_split(std::string_view name);
+UpperNodes parse_upper_nodes(std::string_view name);
 
 struct GravitySettings {
   Method method = Method::BarnesHut;
@@ -109,6 +146,12 @@ struct GravitySettings {
   std::size_t subdomain_size = 208;
   // Section 4.2 / 5: nodes per sub-tree unit at most (the paper's local store limit).
   std::size_t subtree_nodes = 370;
+  SubdomainSplit subdomain_split = SubdomainSplit::Adaptive;
+  SubtreeSplit subtree_split = SubtreeSplit::Units;
+  // SubtreeSplit::Parts: the paper's number of SPEs (a scene value, never the
+  // thread count, so that results do not depend on the threads).
+  std::size_t subtree_parts = 8;
+  UpperNodes upper_nodes = UpperNodes::Opened;
 };
 
 // Throws std::invalid_argument if a parameter is outside its range.
