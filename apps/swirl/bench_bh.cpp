@@ -306,7 +306,10 @@ int run_bh_lambda(BhLambdaArgs a, const CommonArgs& common) {
     progress(fmt::format("bh-lambda: N = {}: force errors against the direct sum", n));
     std::vector<gravity::ForceErrorCase> cases;
     for (double l : a.openings)
-      for (const auto& s : a.schemes) cases.push_back({gravity::parse_scheme(s), l});
+      for (const auto& s : a.schemes) {
+        const SchemeRun run = parse_run(s);
+        cases.push_back({run.scheme, l, run.splits});
+      }
     gravity::BenchSettings es;
     es.n = n;
     es.threads = all;
