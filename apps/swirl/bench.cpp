@@ -5,6 +5,8 @@
 //   swirl bench bh-table   [--sizes 1024,...,32768] [--schemes ...] [--iterations 50] [--opening 0.5]
 //   swirl bench bh-lambda  [--sizes 4096,32768] [--lambdas 0.3,0.5,0.7,0.9] [--schemes ...] [--iterations 20]
 //   swirl bench bh-phases  [--sizes ...] [--schemes subtree] [--iterations 50] [--opening 0.5]
+//   swirl bench bh-opt     [--sizes 1024,...,32768] [--schemes subtree,subdomain] [--iterations N] [--rounds 3]
+//                          [--opening 0.5] [--bin-dir DIR]
 // and on every suite: --out DIR (default bench/results/<suite>), --threads 1,2 (default 1 .. all), --quick.
 #include <fstream>
 #include <iterator>
@@ -116,6 +118,18 @@ void add_bench_commands(CLI::App& app, Commands& commands) {
   c->add_option("--schemes", bp->schemes, kSchemesHelp)->delimiter(',');
   c->add_option("--iterations", bp->iterations, "Iterations")->check(whole_number(1, kMaxCount));
   c->add_option("--opening", bp->opening, "Opening criterion lambda")->check(number_in(0.0, 1.0));
+
+  auto bo = std::make_shared<bench::BhOptArgs>();
+  c = add_suite(bench_cmd, commands, "bh-opt",
+                "Barnes-Hut built at -O0, -O1, -O2, -O3: the paper's Table 2 (needs cmake --build build --target swirl_bh_opt)",
+                common, [bo, common] { return bench::run_bh_opt(*bo, *common); });
+  c->add_option("--sizes", bo->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
+  c->add_option("--schemes", bo->schemes, "subtree,subdomain,global (on the paper's tree)")->delimiter(',');
+  c->add_option("--iterations", bo->iterations, "Iterations per run (default 50 * 1024 / N, 2 .. 50)")
+      ->check(whole_number(1, kMaxCount));
+  c->add_option("--rounds", bo->rounds, "Runs per level, the levels alternated (medians)")->check(whole_number(1, 1000));
+  c->add_option("--opening", bo->opening, "Opening criterion lambda")->check(number_in(0.0, 1.0));
+  c->add_option("--bin-dir", bo->bin_dir, "Directory of swirl_bh_opt_O0 .. _O3 (default: the swirl executable's)");
 
   // Further suites register here (one line each).
   add_bench_bh_scale(*bench_cmd, commands);

@@ -5,6 +5,7 @@
 //   bh-table    paper Table 2, Figures 9-13                          (bench_bh.cpp)
 //   bh-lambda   paper Figures 14-15: λ against time and force error  (bench_bh.cpp)
 //   bh-phases   paper Table 1: time per phase                         (bench_bh.cpp)
+//   bh-opt      paper Table 2's none/-O1/-O2/-O3 columns               (bench_bh_opt.cpp)
 //
 // A suite measures, fills a SuiteReport (tables whose seed columns say where
 // their figures come from, notes, plots) and publish() prints the tables as
@@ -146,10 +147,22 @@ struct BhPhasesArgs {
   double opening = 0.5;
 };
 
+// bh-opt runs the programs swirl_bh_opt_O0 .. _O3 (apps/bh_opt: the same
+// experiment built at each level), which the default build leaves out.
+struct BhOptArgs {
+  std::vector<std::size_t> sizes{1024, 2048, 4096, 8192, 16384, 32768};
+  std::vector<std::string> schemes{"subtree", "subdomain"};
+  int iterations = 0;  // 0: 50 · 1024 / N, 2 .. 50 (the -O0 build is slow)
+  int rounds = 3;      // runs per level, levels alternated; medians
+  double opening = 0.5;
+  std::string bin_dir;  // where the programs are; empty: beside the swirl executable
+};
+
 int run_sph_table(SphTableArgs args, const CommonArgs& common);
 int run_hash_stats(HashStatsArgs args, const CommonArgs& common);
 int run_bh_table(BhTableArgs args, const CommonArgs& common);
 int run_bh_lambda(BhLambdaArgs args, const CommonArgs& common);
 int run_bh_phases(BhPhasesArgs args, const CommonArgs& common);
+int run_bh_opt(BhOptArgs args, const CommonArgs& common);
 
 }  // namespace swirl::cli::bench
