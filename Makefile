@@ -4,7 +4,8 @@
 #   make test   install what is missing, build, run every test with CTest, then the
 #               parallel tests under ThreadSanitizer and a fuzz smoke run (60 s per target)
 #
-# Other targets: build, bench (the seeds' experiments -> docs/performance.md), unit-test (CTest only), asan-test (tests under
+# Other targets: python (the Python module into build-python/venv; docs/python.md),
+# python-test (pytest; part of test), build, bench (the seeds' experiments -> docs/performance.md), unit-test (CTest only), asan-test (tests under
 # AddressSanitizer+UBSan, long tests skipped), tsan-test (the parallel tests
 # under ThreadSanitizer), fuzz (libFuzzer smoke run; FUZZ_SECONDS=600 for
 # longer), debug, clean, deps.
@@ -20,12 +21,13 @@ DEMO_OUT ?= out/demo
 DEB_BUILD_PACKAGES := cmake ninja-build g++ make git pkg-config \
                       libtomlplusplus-dev libcli11-dev libfmt-dev \
                       libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core
-DEB_TEST_PACKAGES  := libgtest-dev libbenchmark-dev python3-matplotlib
+# python3-venv, python3-dev and python3-numpy: the Python module's venv (make python).
+DEB_TEST_PACKAGES  := libgtest-dev libbenchmark-dev python3-matplotlib python3-venv python3-dev python3-numpy
 DEB_PACKAGES       := $(DEB_BUILD_PACKAGES) $(DEB_TEST_PACKAGES)
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
 
-.PHONY: all deps deps-build configure build test unit-test demo bench asan-test tsan-test fuzz debug clean
+.PHONY: all deps deps-build configure build test unit-test python python-test demo bench asan-test tsan-test fuzz debug clean
 
 all: build
 
@@ -49,11 +51,27 @@ configure: deps
 build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
 
-test: unit-test tsan-test fuzz
+test: unit-test python-test tsan-test fuzz
 
 unit-test: build
 	ctest --preset $(PRESET)
 	bash tools/check_simd_objects.sh build$(if $(filter-out release,$(PRESET)),-$(PRESET))
+
+# The Python module (python/, docs/python.md), built by `pip install .` into a
+# venv of Debian's Python (/usr/bin/python3 with its numpy and matplotlib; the
+# python3 on PATH may be another): build-python/venv, CMake tree in
+# build-python/build (position-independent libraries; the CLI's trees are untouched).
+PY_VENV := build-python/venv
+python: deps
+	@[ -x $(PY_VENV)/bin/python ] || /usr/bin/python3 -m venv --system-site-packages $(PY_VENV)
+	$(PY_VENV)/bin/pip install -q -r python/requirements-dev.txt
+	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PY_VENV)/bin/pip install -q --no-build-isolation \
+	  --config-settings=build-dir=build-python/build $(if $(shell command -v ccache),--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache) .
+
+# pytest on the installed module; the CLI of `make build` is the reference of
+# the byte-identical frames test.
+python-test: python build
+	SWIRL_CLI=$(CURDIR)/build/swirl $(PY_VENV)/bin/python -m pytest -q python/tests
 
 # The demo builds only the tool, in its own tree (preset demo: release, tests
 # off, build-demo/), so a fresh machine neither installs nor compiles the test
@@ -92,4 +110,4 @@ debug: deps
 	cmake --build --preset debug -j $(JOBS)
 
 clean:
-	rm -rf build build-demo build-debug build-asan build-tsan build-fuzz build-portable out
+	rm -rf build build-demo build-debug build-asan build-tsan build-fuzz build-portable build-python out

@@ -1,0 +1,34 @@
+// The C++ side of the Python module swirl (python/swirl/ is the Python side,
+// docs/python.md the user's page). This layer is thin and private (every name
+// it binds is reached through the Python classes, which carry the docstrings):
+//   scene.cpp       scenes from files and TOML text: scene/load.hpp, nothing else
+//   simulation.cpp  a Simulation<float|double> built by sim/build.hpp, stepped
+//                   with the GIL released, its fields as zero-copy numpy arrays
+//   run.cpp         sim::run_scene (frames, diagnostics, checkpoints, resume) as
+//                   `swirl run` calls it, and the summary as a dict
+#pragma once
+
+#include <nanobind/nanobind.h>
+
+#include "swirl/scene/scene.hpp"
+
+namespace swirl::python {
+
+namespace nb = nanobind;
+
+// A validated scene, as the loader returns it.
+struct PyScene {
+  scene::Scene scene;
+};
+
+void bind_scene(nb::module_& m);
+void bind_simulation(nb::module_& m);
+void bind_run(nb::module_& m);
+
+// Raises KeyboardInterrupt (or whatever a signal handler raised) if a signal
+// arrived. Call with the GIL held, between steps.
+inline void check_signals() {
+  if (PyErr_CheckSignals() != 0) throw nb::python_error();
+}
+
+}  // namespace swirl::python

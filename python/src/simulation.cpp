@@ -1,0 +1,384 @@
+// A Simulation<float|double> for Python: built by sim::build_simulation (as
+// `swirl run` builds it), stepped with the GIL released and signals checked
+// between steps, its fields handed out as numpy arrays on the C++ memory.
+//
+// Views: field() returns a numpy array whose data is the field's own
+// AlignedVector storage and whose owner is the Python simulation object (the
+// memory lives as long as the array refers to it... until the particles are
+// reordered or resized: a reorder swaps every field with a scratch buffer, so
+// the old storage is freed). The Python side (python/swirl/_views.py) never
+// hands out such an array unchecked: it keeps the epoch and the count it was
+// made at and compares them (and the data pointer) before every use.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/unique_ptr.h>
+
+#include "bindings.hpp"
+#include "swirl/io/csv.hpp"
+#include "swirl/io/vtp.hpp"
+#include "swirl/scene/validate.hpp"
+#include "swirl/sim/build.hpp"
+#include "swirl/sim/observer.hpp"
+
+namespace swirl::python {
+namespace {
+
+// What Python sees of a Simulation<Real>, whichever Real.
+class AnySimulation {
+ public:
+  virtual ~AnySimulation() = default;
+  virtual void step(std::optional<double> land_at) = 0;
+  virtual double time() const = 0;
+  virtual std::uint64_t steps() const = 0;
+  virtual std::uint64_t epoch() const = 0;
+  virtual std::size_t size() const = 0;
+  virtual double last_dt() const = 0;
+  virtual double proposed_dt() const = 0;
+  virtual bool adaptive() const = 0;
+  virtual double dt() const = 0;
+  virtual std::string precision() const = 0;
+  // The array of one component of a field (name, component) on the C++ memory.
+  virtual nb::object field(nb::handle owner, const std::string& name, int component) = 0;
+  virtual std::uintptr_t data_pointer(const std::string& name, int component) = 0;
+  // Reads element i straight from the C++ storage (tests compare views with it).
+  virtual double value(const std::string& name, int component, std::size_t i) = 0;
+  // (name, components, kind "real" | "int" | "id", internal) for every field.
+  virtual nb::list fields() = 0;
+  virtual nb::dict diagnostics() = 0;
+  virtual nb::dict metrics() = 0;
+  virtual nb::dict phases() = 0;
+  virtual void write_frame(const std::string& path, const std::string& format) = 0;
+};
+
+template <class Real>
+class TypedSimulation final : public AnySimulation {
+ public:
+  TypedSimulation(const scene::Scene& scene, bool walls, double restitution)
+      : sim_(sim::build_simulation<Real>(scene)), block_size_(scene.block_size) {
+    sim_.start();
+    conservative_ = std::all_of(sim_.solvers().begin(), sim_.solvers().end(),
+                                [](const auto& s) { return s->conserves_energy(); }) &&
+                    (!walls || restitution == 1);
+    initial_energy_ = energies().total;
+  }
+
+  void step(std::optional<double> land_at) override { sim_.step(land_at); }
+  double time() const override { return sim_.time(); }
+  std::uint64_t steps() const override { return sim_.step_count(); }
+  std::uint64_t epoch() const override { return sim_.epoch(); }
+  std::size_t size() const override { return sim_.particles().size(); }
+  double last_dt() const override { return sim_.last_dt(); }
+  double proposed_dt() const override { return sim_.proposed_dt(); }
+  bool adaptive() const override { return sim_.settings().adaptive; }
+  double dt() const override { return sim_.settings().dt; }
+  std::string precision() const override { return std::is_same_v<Real, float> ? "float" : "double"; }
+
+  nb::object field(nb::handle owner, const std::string& name, int component) override {
+    const Located where = locate(name, component);
+    const std::size_t shape[1] = {size()};
+    if (where.real) return nb::cast(nb::ndarray<nb::numpy, Real, nb::ndim<1>>(where.real, 1, shape, owner));
+    if (where.integer)
+      return nb::cast(nb::ndarray<nb::numpy, std::int32_t, nb::ndim<1>>(where.integer, 1, shape, owner));
+    // Ids are the particles' identities: read-only.
+    return nb::cast(nb::ndarray<nb::numpy, const std::uint64_t, nb::ndim<1>>(where.id, 1, shape, owner));
+  }
+  std::uintptr_t data_pointer(const std::string& name, int component) override {
+    const Located where = locate(name, component);
+    return where.real ? reinterpret_cast<std::uintptr_t>(where.real)
+           : where.integer ? reinterpret_cast<std::uintptr_t>(where.integer)
+                           : reinterpret_cast<std::uintptr_t>(where.id);
+  }
+  double value(const std::string& name, int component, std::size_t i) override {
+    if (i >= size()) throw nb::index_error(fmt::format("particle index {} out of range (n = {})", i, size()).c_str());
+    const Located where = locate(name, component);
+    return where.real ? double(where.real[i]) : where.integer ? double(where.integer[i]) : double(where.id[i]);
+  }
+  nb::list fields() override {
+    nb::list out;
+    auto& p = sim_.particles();
+    for (const auto& f : p.fields()) out.append(nb::make_tuple(std::string(f.name), f.components, "real", f.internal));
+    for (const auto& f : p.int_fields()) out.append(nb::make_tuple(std::string(f.name), 1, "int", f.internal));
+    out.append(nb::make_tuple("id", 1, "id", false));
+    return out;
+  }
+
+  // The figures of one row of diagnostics.csv (sim/run.cpp's DiagnosticsLog):
+  // energies, momentum, angular momentum about the origin, and every solver's own columns.
+  nb::dict diagnostics() override {
+    const Energies e = energies();
+    nb::dict d;
+    d["time"] = sim_.time();
+    d["step"] = sim_.step_count();
+    d["kinetic_energy"] = e.kinetic;
+    d["potential_energy"] = e.potential;
+    d["total_energy"] = e.total;
+    if (conservative_)
+      d["relative_energy_error"] = initial_energy_ != 0 ? (e.total - initial_energy_) / std::abs(initial_energy_) : 0.0;
+    const char* axes[3] = {"x", "y", "z"};
+    for (int k = 0; k < 3; ++k) d[fmt::format("momentum_{}", axes[k]).c_str()] = e.momentum[static_cast<std::size_t>(k)];
+    for (int k = 0; k < 3; ++k)
+      d[fmt::format("angular_momentum_{}", axes[k]).c_str()] = e.angular[static_cast<std::size_t>(k)];
+    std::vector<double> row;
+    std::vector<std::string> names;
+    for (const auto& s : sim_.solvers()) {
+      for (const auto& c : s->diagnostic_columns()) names.push_back(c);
+      s->add_diagnostics(sim_.particles(), block_size_, row);
+    }
+    for (std::size_t k = 0; k < names.size() && k < row.size(); ++k) d[names[k].c_str()] = row[k];
+    return d;
+  }
+  nb::dict metrics() override {
+    NamedValues values;
+    for (const auto& s : sim_.solvers()) s->add_metrics(values);
+    if (sim_.order().active()) values.emplace_back("sorts", double(sim_.order().sorts()));
+    nb::dict d;
+    for (const auto& [k, v] : values) d[k.c_str()] = v;
+    return d;
+  }
+  nb::dict phases() override {
+    nb::dict d;
+    for (const auto& [k, v] : sim_.timers().phases()) d[k.c_str()] = v;
+    return d;
+  }
+  // One frame file as the run's frame writer writes it (the same io:: writer).
+  void write_frame(const std::string& path, const std::string& format) override {
+    if (format == "vtp") io::write_vtp(path, sim_.particles(), sim_.time());
+    else if (format == "csv") io::write_csv(path, sim_.particles(), sim_.time());
+    else throw nb::value_error(fmt::format("format '{}': give \"vtp\" or \"csv\"", format).c_str());
+  }
+
+ private:
+  struct Located {
+    Real* real = nullptr;
+    std::int32_t* integer = nullptr;
+    const std::uint64_t* id = nullptr;
+  };
+  Located locate(const std::string& name, int component) {
+    auto& p = sim_.particles();
+    if (name == "id") {
+      if (component != 0) throw nb::index_error("field 'id' has one component");
+      return {nullptr, nullptr, p.id.data()};
+    }
+    for (const auto& f : p.fields())
+      if (f.name == name) {
+        if (component < 0 || component >= f.components)
+          throw nb::index_error(fmt::format("field '{}' has {} component(s), not component {}", name, f.components,
+                                            component).c_str());
+        return {f.data[static_cast<std::size_t>(component)], nullptr, nullptr};
+      }
+    for (const auto& f : p.int_fields())
+      if (f.name == name) {
+        if (component != 0) throw nb::index_error(fmt::format("field '{}' has one component", name).c_str());
+        return {nullptr, f.data[0], nullptr};
+      }
+    std::string known;
+    for (const auto& f : p.fields()) known += (known.empty() ? "" : ", ") + std::string(f.name);
+    for (const auto& f : p.int_fields()) known += ", " + std::string(f.name);
+    throw nb::key_error(fmt::format("no particle field '{}' (the fields: {}, id)", name, known).c_str());
+  }
+
+  struct Energies {
+    double kinetic = 0, potential = 0, total = 0;
+    std::array<double, 3> momentum{}, angular{};
+  };
+  Energies energies() const {
+    const auto& p = sim_.particles();
+    Energies e;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double m = p.mass[i];
+      const double x = p.position.x[i], y = p.position.y[i], z = p.position.z[i];
+      const double vx = p.velocity.x[i], vy = p.velocity.y[i], vz = p.velocity.z[i];
+      e.kinetic += 0.5 * m * (vx * vx + vy * vy + vz * vz);
+      e.momentum[0] += m * vx, e.momentum[1] += m * vy, e.momentum[2] += m * vz;
+      e.angular[0] += m * (y * vz - z * vy), e.angular[1] += m * (z * vx - x * vz), e.angular[2] += m * (x * vy - y * vx);
+    }
+    for (const auto& s : sim_.solvers()) e.potential += s->potential_energy(p, block_size_);
+    e.total = e.kinetic + e.potential;
+    return e;
+  }
+
+  Simulation<Real> sim_;
+  std::size_t block_size_;
+  bool conservative_ = true;
+  double initial_energy_ = 0;
+};
+
+std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene) {
+  if (scene.precision == scene::Precision::Float)
+    return std::make_unique<TypedSimulation<float>>(scene, scene.walls, scene.restitution);
+  return std::make_unique<TypedSimulation<double>>(scene, scene.walls, scene.restitution);
+}
+
+// The Python-facing object: the simulation and the stepping loops.
+class PySimulation {
+ public:
+  explicit PySimulation(std::unique_ptr<AnySimulation> sim) : sim_(std::move(sim)) {}
+
+  AnySimulation& sim() { return *sim_; }
+
+  // n steps; signals (Ctrl-C) are checked after each one.
+  void step(std::uint64_t n) {
+    for (std::uint64_t k = 0; k < n; ++k) {
+      {
+        nb::gil_scoped_release release;
+        sim_->step(std::nullopt);
+      }
+      check_signals();
+    }
+  }
+
+  // Steps until time `until` or `steps` more steps; calls callback() after
+  // each step at which it is due (every_time: at the first step whose time is
+  // >= k·every_time; every_steps: every that many steps); a callback that
+  // returns False stops the run. Returns whether the callback stopped it.
+  bool run(std::optional<double> until, std::optional<std::uint64_t> steps, std::optional<double> every_time,
+           std::optional<std::uint64_t> every_steps, nb::object callback) {
+    const std::uint64_t first = sim_->steps();
+    std::uint64_t end_step = 0;
+    if (steps) {
+      end_step = first + *steps;
+    } else if (!sim_->adaptive()) {
+      // The step whose time is >= until (the rounding of Scene::total_steps).
+      end_step = static_cast<std::uint64_t>(std::max(0.0, std::ceil(*until / sim_->dt() - 1e-9)));
+    }
+    sim::IntervalSchedule schedule(every_time.value_or(0), sim_->dt());
+    if (schedule.enabled()) schedule.acted(sim_->time());
+    auto running = [&] { return steps || !sim_->adaptive() ? sim_->steps() < end_step : sim_->time() < *until; };
+    while (running()) {
+      std::optional<double> land;
+      if (sim_->adaptive()) {
+        if (until) land = until;
+        if (const auto t = schedule.next_time(); t && (!land || *t < *land)) land = t;
+      }
+      {
+        nb::gil_scoped_release release;
+        sim_->step(land);
+      }
+      check_signals();
+      bool due = every_steps && (sim_->steps() - first) % *every_steps == 0;
+      if (schedule.due(sim_->time())) {
+        schedule.acted(sim_->time());
+        due = true;
+      }
+      if (due && !callback.is_none()) {
+        nb::object result = callback();
+        if (result.is(nb::bool_(false))) return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  std::unique_ptr<AnySimulation> sim_;
+};
+
+// One row of a (n, 3) or (n,) array of doubles, checked finite.
+void check_finite(const double* data, std::size_t n, std::size_t columns, const char* what) {
+  for (std::size_t i = 0; i < n * columns; ++i)
+    if (!std::isfinite(data[i]))
+      throw nb::value_error(columns == 1 ? fmt::format("{}[{}] is {}, not a finite number", what, i, data[i]).c_str()
+                                         : fmt::format("{}[{}, {}] is {}, not a finite number", what, i / columns,
+                                                       i % columns, data[i]).c_str());
+}
+
+using Rows = nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using Column = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+
+// The scene's physics with these particles instead of its [[particles]]:
+// one list source, validated as a scene file's list is.
+std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, std::optional<Rows> velocities,
+                                           Column masses) {
+  const std::size_t n = positions.shape(0);
+  if (positions.shape(1) != 3) throw nb::value_error("positions must have shape (n, 3)");
+  if (velocities && (velocities->shape(0) != n || velocities->shape(1) != 3))
+    throw nb::value_error(fmt::format("velocities must have shape ({}, 3), like positions", n).c_str());
+  if (masses.shape(0) != n) throw nb::value_error(fmt::format("masses must have shape ({},), one per position", n).c_str());
+  check_finite(positions.data(), n, 3, "positions");
+  if (velocities) check_finite(velocities->data(), n, 3, "velocities");
+  check_finite(masses.data(), n, 1, "masses");
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(masses.data()[i] > 0)) throw nb::value_error(fmt::format("masses[{}] is {}: a mass must be > 0", i, masses.data()[i]).c_str());
+  scene::Scene s = base.scene;
+  scene::ListSource list;
+  list.positions.resize(n);
+  list.masses.assign(masses.data(), masses.data() + n);
+  for (std::size_t i = 0; i < n; ++i)
+    list.positions[i] = {positions.data()[3 * i], positions.data()[3 * i + 1], positions.data()[3 * i + 2]};
+  if (velocities) {
+    list.velocities.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      list.velocities[i] = {velocities->data()[3 * i], velocities->data()[3 * i + 1], velocities->data()[3 * i + 2]};
+  }
+  s.sources = {std::move(list)};
+  s.random_box.reset();
+  s.toml.clear();  // the file's particles are not these
+  s.file = (base.scene.file.empty() ? std::string("scene") : base.scene.file) + " (particles from arrays)";
+  scene::validate(s);
+  nb::gil_scoped_release release;
+  return make_simulation(s);
+}
+
+}  // namespace
+
+void bind_simulation(nb::module_& m) {
+  nb::class_<PySimulation>(m, "Simulation")
+      .def("__init__",
+           [](PySimulation* self, const PyScene& s) {
+             std::unique_ptr<AnySimulation> sim;
+             {
+               nb::gil_scoped_release release;
+               sim = make_simulation(s.scene);
+             }
+             new (self) PySimulation(std::move(sim));
+           },
+           nb::arg("scene"))
+      .def_static(
+          "from_arrays",
+          [](const PyScene& s, Rows positions, std::optional<Rows> velocities, Column masses) {
+            return new PySimulation(from_arrays(s, positions, velocities, masses));
+          },
+          nb::arg("scene"), nb::arg("positions").noconvert(), nb::arg("velocities").noconvert().none(),
+          nb::arg("masses").noconvert(), nb::rv_policy::take_ownership)
+      .def("step", &PySimulation::step, nb::arg("n"))
+      .def("run", &PySimulation::run, nb::arg("until").none(), nb::arg("steps").none(), nb::arg("every_time").none(),
+           nb::arg("every_steps").none(), nb::arg("callback").none())
+      .def_prop_ro("time", [](PySimulation& s) { return s.sim().time(); })
+      .def_prop_ro("steps", [](PySimulation& s) { return s.sim().steps(); })
+      .def_prop_ro("epoch", [](PySimulation& s) { return s.sim().epoch(); })
+      .def_prop_ro("count", [](PySimulation& s) { return s.sim().size(); })
+      .def_prop_ro("last_dt", [](PySimulation& s) { return s.sim().last_dt(); })
+      .def_prop_ro("proposed_dt", [](PySimulation& s) { return s.sim().proposed_dt(); })
+      .def_prop_ro("precision", [](PySimulation& s) { return s.sim().precision(); })
+      .def(
+          "field",
+          [](nb::handle self, const std::string& name, int component) {
+            return nb::cast<PySimulation&>(self).sim().field(self, name, component);
+          },
+          nb::arg("name"), nb::arg("component"))
+      .def("data_pointer", [](PySimulation& s, const std::string& name, int c) { return s.sim().data_pointer(name, c); })
+      .def("value", [](PySimulation& s, const std::string& name, int c, std::size_t i) { return s.sim().value(name, c, i); })
+      .def("fields", [](PySimulation& s) { return s.sim().fields(); })
+      .def("diagnostics", [](PySimulation& s) { return s.sim().diagnostics(); })
+      .def("metrics", [](PySimulation& s) { return s.sim().metrics(); })
+      .def("phases", [](PySimulation& s) { return s.sim().phases(); })
+      .def("write_frame", [](PySimulation& s, const std::string& path, const std::string& format) {
+        nb::gil_scoped_release release;
+        s.sim().write_frame(path, format);
+      });
+}
+
+}  // namespace swirl::python

@@ -1,0 +1,101 @@
+"""Runs into run folders, as ``swirl run`` makes them (frames, diagnostics, checkpoints)."""
+
+import csv
+import numbers
+import os
+
+import numpy as np
+
+from . import _swirl
+from ._scene import Scene
+
+
+def _positive_int(name, value):
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+        raise ValueError(f"{name}={value!r}: give a whole number >= 1")
+    return int(value)
+
+
+def _positive_float(name, value):
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not (np.isfinite(value) and value > 0):
+        raise ValueError(f"{name}={value!r}: give a finite number > 0")
+    return float(value)
+
+
+def _run(scene, out, resume, steps, until, threads, overwrite, checkpoint_every, checkpoint_every_steps,
+         checkpoint_keep, on_blowup, progress):
+    if steps is not None and until is not None:
+        raise ValueError("give steps=N or until=T, not both")
+    if threads is None:
+        threads = 0
+    elif isinstance(threads, bool) or not isinstance(threads, numbers.Integral) or threads < 1:
+        raise ValueError(f"threads={threads!r}: give a whole number >= 1 (or None: all cores)")
+    if progress is not None and not callable(progress):
+        raise TypeError("progress must be callable as progress(dict)")
+    return _swirl.run_scene(scene._scene, os.fspath(out), resume, _positive_int("steps", steps),
+                            _positive_float("until", until), int(threads), bool(overwrite),
+                            _positive_float("checkpoint_every", checkpoint_every),
+                            _positive_int("checkpoint_every_steps", checkpoint_every_steps),
+                            _positive_int("checkpoint_keep", checkpoint_keep), on_blowup, progress)
+
+
+def run(scene, out, *, steps=None, until=None, threads=None, overwrite=False, checkpoint_every=None,
+        checkpoint_every_steps=None, checkpoint_keep=2, on_blowup="stop", progress=None):
+    """Runs a scene into the run folder ``out``, as ``swirl run SCENE --out OUT`` does; returns the summary dict.
+
+    The same run loop as the CLI (sim/run.cpp): frames ``particles_NNNNNN.vtp``
+    (or .csv) at ``output.interval`` with ``particles.pvd``, ``diagnostics.csv``,
+    ``scene.toml``, the manifest, and checkpoints in ``out/checkpoints/``.
+    ``scene``: a ``swirl.Scene`` or a scene file path.
+    ``steps`` / ``until``: run that many steps, or to that simulated time,
+    instead of the scene's end (``--steps`` / ``--until``).
+    ``threads``: threads for this run (default: all cores or ``OMP_NUM_THREADS``).
+    ``overwrite``: replace a run already in ``out`` (only the files its manifest lists).
+    ``checkpoint_every`` (simulated time) / ``checkpoint_every_steps`` /
+    ``checkpoint_keep`` (default 2): as the CLI's checkpoint options.
+    ``on_blowup``: ``"stop"`` (default), ``"warn"`` or ``"off"``.
+    ``progress(d)``: called after every step with ``step``, ``first_step``,
+    ``total_steps``, ``time``, ``wall_seconds``; returning False stops the run.
+
+    Ctrl-C (or an exception from ``progress``) stops the run after the
+    current step, writes a checkpoint (``swirl.resume(out)`` continues), and
+    is raised. A blow-up does not raise: the summary's ``error`` says it, as
+    the CLI's summary does, and every frame and checkpoint before it is kept.
+    The summary has the keys of ``swirl run --summary-json``.
+    """
+    if isinstance(scene, (str, os.PathLike)):
+        scene = Scene.from_file(scene)
+    if not isinstance(scene, Scene):
+        raise TypeError(f"run(scene, ...): give a swirl.Scene or a scene file path, not a {type(scene).__name__}")
+    return _run(scene, out, False, steps, until, threads, overwrite, checkpoint_every, checkpoint_every_steps,
+                checkpoint_keep, on_blowup, progress)
+
+
+def resume(run_dir, *, steps=None, until=None, threads=None, checkpoint_every=None, checkpoint_every_steps=None,
+           checkpoint_keep=2, on_blowup="stop", progress=None):
+    """Continues the run in ``run_dir`` from its newest valid checkpoint, as ``swirl run --resume RUN_DIR``.
+
+    The scene is the one saved there (``run_dir/scene.toml``); the result is
+    bit-identical to a run that never stopped. ``steps``: that many more steps;
+    ``until``: to that time; default: where the first invocation would have
+    ended. Other arguments as ``swirl.run``. Returns the summary dict.
+    """
+    scene = Scene.from_file(os.path.join(os.fspath(run_dir), "scene.toml"))
+    return _run(scene, run_dir, True, steps, until, threads, False, checkpoint_every, checkpoint_every_steps,
+                checkpoint_keep, on_blowup, progress)
+
+
+def read_diagnostics(run_dir):
+    """A run folder's ``diagnostics.csv`` as a dict of numpy arrays, one per column (``limited_by``: str)."""
+    with open(os.path.join(os.fspath(run_dir), "diagnostics.csv"), newline="") as f:
+        rows = list(csv.reader(f))
+    header, body = rows[0], rows[1:]
+    out = {}
+    for k, name in enumerate(header):
+        column = [r[k] for r in body]
+        out[name] = np.array(column) if name == "limited_by" else np.array(column, dtype=np.float64)
+    return out

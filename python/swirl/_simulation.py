@@ -1,0 +1,241 @@
+"""swirl.Simulation: a scene's simulation, stepped from Python."""
+
+import numbers
+import os
+
+import numpy as np
+
+from . import _swirl
+from ._scene import Scene
+from ._views import Particles
+
+
+def _check_array(name, a, ndim, n=None):
+    """The checks of from_arrays: a C-contiguous float32/float64 ndarray of the right shape, all finite."""
+    if not isinstance(a, np.ndarray):
+        raise TypeError(f"{name} must be a numpy array, not a {type(a).__name__}")
+    if a.dtype not in (np.float32, np.float64):
+        raise TypeError(f"{name} has dtype {a.dtype}: give float32 or float64")
+    shape = "(n, 3)" if ndim == 2 else "(n,)"
+    if a.ndim != ndim or (ndim == 2 and a.shape[1] != 3):
+        raise ValueError(f"{name} has shape {a.shape}: it must be {shape}")
+    if n is not None and a.shape[0] != n:
+        raise ValueError(f"{name} has {a.shape[0]} rows but positions has {n}: one per particle")
+    if not a.flags.c_contiguous:
+        raise ValueError(f"{name} is not C-contiguous (a slice or a transpose?): pass np.ascontiguousarray({name})")
+    if not np.all(np.isfinite(a)):
+        bad = np.argwhere(~np.isfinite(a))[0]
+        where = ", ".join(str(int(i)) for i in bad)
+        raise ValueError(f"{name}[{where}] is {a[tuple(bad)]}, not a finite number")
+    return np.asarray(a, dtype=np.float64)
+
+
+class Simulation:
+    """A running simulation of a scene: particles, solvers, stepper and clock.
+
+    ``Simulation(scene)`` builds exactly what ``swirl run`` builds for the
+    scene (the same particles, solvers, stepper and guard; sim/build.hpp) and
+    computes the initial forces. ``scene`` is a ``swirl.Scene`` or a path to
+    a scene file.
+
+    Stepping: ``step(n=1)`` takes n steps; ``run(until=t, ...)`` steps to a
+    time, calling a callback on the way. The engine runs with the GIL
+    released, on the threads of ``swirl.set_threads`` (default: all cores or
+    ``OMP_NUM_THREADS``, as the CLI); results are bit-identical for any
+    thread count. Ctrl-C stops after the current step with
+    ``KeyboardInterrupt``; the state is that after the step, consistent.
+
+    Reading and writing the state: ``particles`` (zero-copy views of every
+    field, checked against reordering; see ``swirl.Particles``),
+    ``diagnostics()`` (energies, momenta, the solvers' figures),
+    ``write_frame(path)`` (a .vtp/.csv frame as ``swirl run`` writes it).
+
+    A blow-up (a non-finite state, a particle leaving the box, a step beyond
+    the stability condition) raises ``swirl.SimulationError`` naming the
+    step, the particle and a fix, as the CLI reports it.
+    """
+
+    __slots__ = ("_native", "_scene", "__weakref__")
+
+    def __init__(self, scene):
+        if isinstance(scene, (str, os.PathLike)):
+            scene = Scene.from_file(scene)
+        if not isinstance(scene, Scene):
+            raise TypeError(f"Simulation(scene): give a swirl.Scene or a scene file path, not a {type(scene).__name__}")
+        self._scene = scene
+        self._native = _swirl.Simulation(scene._scene)
+
+    @classmethod
+    def from_arrays(cls, scene, positions, velocities=None, masses=None):
+        """A simulation of the scene's physics with these particles instead of its ``[[particles]]``.
+
+        ``positions``: (n, 3) array (m, or N-body length); ``velocities``:
+        (n, 3) (m/s), default at rest; ``masses``: (n,) array (kg), or one
+        number for every particle (required). Arrays must be numpy float32 or
+        float64, C-contiguous, finite, of matching lengths; anything else
+        raises TypeError or ValueError naming the array. The particles get
+        ids 0..n-1 in the order given, and are checked as a scene file's
+        ``kind = "list"`` source is (inside the box, ...): ``SceneError``.
+        The fields are stored in the scene's precision (``scene.precision``)
+        whatever the arrays' dtype. Every other setting (dt, solvers, box,
+        output) is the scene's.
+        """
+        if isinstance(scene, (str, os.PathLike)):
+            scene = Scene.from_file(scene)
+        if not isinstance(scene, Scene):
+            raise TypeError(f"from_arrays(scene, ...): give a swirl.Scene, not a {type(scene).__name__}")
+        pos = _check_array("positions", positions, 2)
+        n = pos.shape[0]
+        if n == 0:
+            raise ValueError("positions is empty: give at least one particle")
+        vel = None if velocities is None else _check_array("velocities", velocities, 2, n)
+        if masses is None:
+            raise TypeError("from_arrays needs masses: an (n,) array, or one number for all particles")
+        if isinstance(masses, numbers.Real) and not isinstance(masses, bool):
+            mass = np.full(n, float(masses))
+            if not np.isfinite(mass[0]) or mass[0] <= 0:
+                raise ValueError(f"masses = {masses}: a mass must be finite and > 0")
+        else:
+            mass = _check_array("masses", masses, 1, n)
+        self = cls.__new__(cls)
+        self._scene = scene
+        self._native = _swirl.Simulation.from_arrays(scene._scene, pos, vel, mass)
+        return self
+
+    # -- stepping ----------------------------------------------------------
+    def step(self, n=1):
+        """Takes ``n`` steps (default 1). The GIL is released while stepping; Ctrl-C stops after the current step."""
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) or n < 0:
+            raise ValueError(f"step(n): n must be a whole number >= 0, not {n!r}")
+        self._native.step(int(n))
+        return self
+
+    def run(self, until=None, *, steps=None, every=None, callback=None):
+        """Steps until simulated time ``until`` (or ``steps`` more steps), calling ``callback`` on the way.
+
+        ``until``: a time (s, or N-body time) past the current one; with a
+        fixed dt the run ends at the first step whose time is >= until (the
+        rounding of the CLI's ``--until``), with adaptive steps exactly at it.
+        ``steps``: instead of ``until``, this many steps.
+        ``every``: when ``callback`` is called: a float is an interval of
+        simulated time (after the first step whose time is >= k·every, as the
+        frame writer's schedule; adaptive steps land on those times), an int
+        a number of steps; default: after every step.
+        ``callback(sim)``: sees the state (``sim.particles`` views are fresh
+        there) and may change it (write into the fields: a force, a kick);
+        returning ``False`` stops the run; an exception stops it and
+        propagates. Returns True when the callback stopped the run, else False.
+        """
+        if (until is None) == (steps is None):
+            raise ValueError("run(): give until=T or steps=N (one of them)")
+        if until is not None:
+            if isinstance(until, bool) or not isinstance(until, numbers.Real) or not np.isfinite(until):
+                raise ValueError(f"run(until={until!r}): until must be a finite time")
+            if until <= self.time:
+                raise ValueError(f"run(until={until}): the simulation is already at t = {self.time:g}; give a later time")
+        if steps is not None and (isinstance(steps, bool) or not isinstance(steps, numbers.Integral) or steps < 0):
+            raise ValueError(f"run(steps={steps!r}): steps must be a whole number >= 0")
+        every_time = every_steps = None
+        if every is None:
+            every_steps = 1
+        elif isinstance(every, bool):
+            raise ValueError("run(every=...): give a time interval (float) or a step count (int)")
+        elif isinstance(every, numbers.Integral):
+            if every < 1:
+                raise ValueError(f"run(every={every}): a step count must be >= 1")
+            every_steps = int(every)
+        elif isinstance(every, numbers.Real):
+            if not (np.isfinite(every) and every > 0):
+                raise ValueError(f"run(every={every}): a time interval must be finite and > 0")
+            every_time = float(every)
+        else:
+            raise ValueError(f"run(every={every!r}): give a time interval (float) or a step count (int)")
+        if callback is not None and not callable(callback):
+            raise TypeError("run(callback=...): the callback must be callable as callback(sim)")
+        call = None if callback is None else (lambda: callback(self))
+        return self._native.run(None if until is None else float(until), None if steps is None else int(steps),
+                                every_time, every_steps, call)
+
+    # -- state ---------------------------------------------------------------
+    @property
+    def scene(self):
+        """The ``swirl.Scene`` this simulation was built from."""
+        return self._scene
+
+    @property
+    def time(self):
+        """Simulated time (s, or N-body time); fixed dt: steps·dt exactly."""
+        return self._native.time
+
+    @property
+    def steps(self):
+        """Steps taken so far; int."""
+        return self._native.steps
+
+    @property
+    def epoch(self):
+        """The particle order's counter: changes whenever the particles were reordered or resized (views check it)."""
+        return self._native.epoch
+
+    @property
+    def dt(self):
+        """The step last taken (0 before the first)."""
+        return self._native.last_dt
+
+    @property
+    def next_dt(self):
+        """The step the next ``step()`` takes: the fixed dt, or the adaptive choice."""
+        return self._native.proposed_dt
+
+    @property
+    def precision(self):
+        """``"float"`` or ``"double"``: the particle fields' type (numpy float32 / float64)."""
+        return self._native.precision
+
+    @property
+    def count(self):
+        """Number of particles; int."""
+        return self._native.count
+
+    def __len__(self):
+        return self._native.count
+
+    @property
+    def particles(self):
+        """The particle fields as zero-copy numpy views (``swirl.Particles``), e.g. ``sim.particles.position.x``."""
+        return Particles(self)
+
+    def diagnostics(self):
+        """The figures of one row of the CLI's diagnostics.csv, as a dict.
+
+        ``time``, ``step``, ``kinetic_energy``, ``potential_energy``,
+        ``total_energy`` (J, or N-body units), ``relative_energy_error``
+        (against the initial state; only when every force and wall conserves
+        energy), ``momentum_x/y/z``, ``angular_momentum_x/y/z`` (about the
+        origin), then every solver's own columns (SPH: density errors, mean
+        neighbours, ...).
+        """
+        return self._native.diagnostics()
+
+    def metrics(self):
+        """The solvers' figures of the CLI's summary (e.g. ``mean_neighbours``, ``sorts``), as a dict."""
+        return self._native.metrics()
+
+    def phases(self):
+        """Seconds spent per phase so far (``forces``, ``forces.sort``, ...), as the CLI's summary; dict."""
+        return self._native.phases()
+
+    def write_frame(self, path, format=None):
+        """Writes the current state as one frame file, with the writer ``swirl run`` uses.
+
+        ``format``: ``"vtp"`` (ParaView) or ``"csv"``; default from the path's suffix.
+        Fields in storage order, with their ids.
+        """
+        path = os.fspath(path)
+        if format is None:
+            format = os.path.splitext(path)[1].lstrip(".").lower()
+        self._native.write_frame(path, format)
+
+    def __repr__(self):
+        return (f"<swirl.Simulation {self._scene.file!r}: {self.count} particles ({self.precision}), "
+                f"step {self.steps}, t = {self.time:g}>")
