@@ -356,7 +356,7 @@ int run_bh_opt(BhOptArgs a, const CommonArgs& common) {
                     {"softening", "0.01"},
                     {"precision", "double"},
                     {"tree", "paper"},
-                    {"programs", (dir / "swirl_bh_opt_O{0,1,2,3}").string()},
+                    {"programs", shown(dir / "swirl_bh_opt_O{0,1,2,3}")},
                     {"programs' compiler", compiler}};
   rep.tables = {t};
   rep.notes = fmt::format(
