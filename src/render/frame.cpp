@@ -5,6 +5,7 @@
 #include <string>
 
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/snapshot.hpp"
 #include "swirl/io/vtp.hpp"
 
 namespace swirl::render {
@@ -57,7 +58,27 @@ std::string_view quantity_name(Quantity q) {
   return "?";
 }
 
+namespace {
+// An HDF5 snapshot as a frame: its Gadget datasets by their names.
+Frame load_snapshot_frame(const std::filesystem::path& file) {
+  const io::SnapshotFile s = io::read_snapshot(file);  // checks shapes and finiteness
+  Frame f;
+  f.file = file;
+  f.time = s.info.time;
+  f.positions = as_vectors(s.datasets.at("Coordinates").values);
+  f.velocity = as_vectors(s.datasets.at("Velocities").values);
+  f.mass = s.datasets.at("Masses").values;
+  const auto scalar = [&](const char* name, std::vector<double>& out) {
+    if (const auto it = s.datasets.find(name); it != s.datasets.end() && it->second.columns == 1) out = it->second.values;
+  };
+  scalar("Density", f.density);
+  scalar("Pressure", f.pressure);
+  return f;
+}
+}  // namespace
+
 Frame load_frame(const std::filesystem::path& file) {
+  if (file.extension() == ".h5") return load_snapshot_frame(file);
   const io::VtpFile vtp = io::read_vtp(file);
   Frame f;
   f.file = file;

@@ -12,6 +12,7 @@
 
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/read_file.hpp"
+#include "swirl/io/snapshot.hpp"
 #include "swirl/render/png.hpp"
 #include "swirl/render/splats.hpp"
 #include "swirl/render/surface_density.hpp"
@@ -126,16 +127,23 @@ RunInfo read_run(const std::filesystem::path& dir) {
   if (fs::exists(pvd)) {
     run.frames = io::read_pvd(pvd);
   } else {
-    std::vector<std::string> names;
-    for (const auto& e : fs::directory_iterator(dir))
-      if (e.is_regular_file() && e.path().extension() == ".vtp" && frame_number(e.path().stem().string()))
-        names.push_back(e.path().filename().string());
-    std::sort(names.begin(), names.end());
-    for (auto& n : names) run.frames.push_back({0.0, std::move(n)});
+    // The .vtp frames, or else the HDF5 snapshots (their times from their headers).
+    for (const char* extension : {".vtp", ".h5"}) {
+      std::vector<std::string> names;
+      for (const auto& e : fs::directory_iterator(dir))
+        if (e.is_regular_file() && e.path().extension() == extension && frame_number(e.path().stem().string()))
+          names.push_back(e.path().filename().string());
+      std::sort(names.begin(), names.end());
+      for (auto& n : names) {
+        const double time = std::string_view(extension) == ".h5" ? io::read_snapshot_layout(dir / n).time : 0.0;
+        run.frames.push_back({time, std::move(n)});
+      }
+      if (!run.frames.empty()) break;
+    }
   }
   if (run.frames.empty())
-    throw io::IoError(dir.string() + ": no frames to render (no particles.pvd or particles_*.vtp); make them with: swirl run SCENE --out " +
-                      dir.string());
+    throw io::IoError(dir.string() + ": no frames to render (no particles.pvd, particles_*.vtp or particles_*.h5); make "
+                      "them with: swirl run SCENE --out " + dir.string());
   const fs::path scene_file = dir / "scene.toml";
   if (fs::exists(scene_file)) {
     // parse_scene on io's checked read: the scene loader's own read would block on a FIFO.
@@ -292,16 +300,21 @@ sim::FrameHook render_every(std::filesystem::path run_dir, std::uint64_t every, 
                                                                   const sim::ClaimFile& claim) {
     const auto number = frame_number(frame.stem().string());
     if (!number || *number % every != 0) return;
-    std::filesystem::path vtp = frame;
-    vtp.replace_extension(".vtp");
-    if (!std::filesystem::exists(vtp))
-      throw io::IoError(vtp.string() + ": rendering needs .vtp frames (output.format must include \"vtp\")");
+    // A .vtp or .h5 frame (the first format written); CSV frames hold too little to draw.
+    std::filesystem::path drawn = frame;
+    for (const char* extension : {".vtp", ".h5"}) {
+      drawn.replace_extension(extension);
+      if (std::filesystem::exists(drawn)) break;
+    }
+    if (!std::filesystem::exists(drawn))
+      throw io::IoError(frame.string() + ": rendering needs .vtp or .h5 frames (output.format must include \"vtp\" "
+                        "or \"hdf5\")");
     if (!*renderer) *renderer = std::make_unique<RunRenderer>(read_run(run_dir), options);
     const std::filesystem::path out = run_dir / "render";
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
     if (ec) throw io::IoError(out.string() + ": cannot create (" + ec.message() + ")");
-    (*renderer)->render_file(vtp, claim(png_path_for(out, vtp)));
+    (*renderer)->render_file(drawn, claim(png_path_for(out, drawn)));
   };
 }
 

@@ -509,8 +509,9 @@ std::vector<SceneKey> declare_scene_keys() {
                      .doc = "`0` writes only the first and the last frame"},
             in_scene(&Scene::output_interval)));
   add(field(SceneKey{.key = "output.format", .section = "output", .noun = "format",
-                     .doc = "each `\"vtp\"` (VTK XML PolyData, for ParaView) or `\"csv\"`; an array names at least "
-                            "one and none twice",
+                     .doc = "each `\"vtp\"` (VTK XML PolyData, for ParaView), `\"hdf5\"` (Gadget-format HDF5 "
+                            "snapshots with an XDMF series for ParaView: docs/scenes.md, Output) or `\"csv\"`; an "
+                            "array names at least one and none twice",
                      .type_doc = "string or array of strings"},
             in_scene(&Scene::formats)));
   return k;

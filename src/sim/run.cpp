@@ -16,7 +16,9 @@
 #include "swirl/io/csv.hpp"
 #include "swirl/io/pvd.hpp"
 #include "swirl/io/run_folder.hpp"
+#include "swirl/io/snapshot.hpp"
 #include "swirl/io/vtp.hpp"
+#include "swirl/io/xdmf.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/scene/validate.hpp"
@@ -27,13 +29,15 @@ namespace swirl::sim {
 namespace {
 
 // ---------------------------------------------------------------------------
-// Frames: particles_NNNNNN.vtp/.csv at the output interval, frame 0 at the
-// start, the final state at the end; particles.pvd kept current.
+// Frames: particles_NNNNNN.vtp/.h5/.csv at the output interval, frame 0 at
+// the start, the final state at the end; particles.pvd (VTK frames) and
+// particles.xdmf (HDF5 snapshots) kept current.
 template <class Real>
 class FrameWriter final : public Observer<Real> {
  public:
   FrameWriter(const scene::Scene& scene, const RunOptions& options, io::RunFolder& folder)
       : formats_(scene.formats), dir_(options.out_dir), series_(dir_ / "particles.pvd"),
+        snapshots_(dir_ / "particles.xdmf"), snapshot_info_(snapshot_info(scene)),
         schedule_(scene.output_interval, scene.dt), on_frame_(options.on_frame), folder_(folder) {}
 
   std::string_view name() const override { return "frames"; }
@@ -61,6 +65,15 @@ class FrameWriter final : public Observer<Real> {
     frames_ = static_cast<std::size_t>(find_value(values, "frames.written").value_or(0));
     schedule_.set_next_index(static_cast<std::uint64_t>(find_value(values, "frames.next").value_or(1)));
     last_step_ = static_cast<std::uint64_t>(find_value(values, "frames.last_step").value_or(0));
+    if (has(scene::OutputFormat::Hdf5)) {
+      // The series from the snapshots written before the checkpoint (their headers and shapes only).
+      std::vector<io::XdmfEntry> entries;
+      for (std::size_t f = 0; f < frames_; ++f) {
+        const std::string name = snapshot_name(f);
+        if (std::filesystem::exists(dir_ / name)) entries.push_back({name, io::read_snapshot_layout(dir_ / name)});
+      }
+      snapshots_.set_entries(std::move(entries));
+    }
     const auto pvd = dir_ / "particles.pvd";
     if (!std::filesystem::exists(pvd)) return;
     auto entries = io::read_pvd(pvd);
@@ -81,6 +94,14 @@ class FrameWriter final : public Observer<Real> {
         io::write_vtp(file, sim.particles(), sim.time());
         folder_.claim(dir_ / "particles.pvd");
         series_.add(sim.time(), name);
+      } else if (format == scene::OutputFormat::Hdf5) {
+        const std::string name = snapshot_name(frames_);
+        file = folder_.claim(dir_ / name);
+        io::SnapshotInfo info = snapshot_info_;
+        info.time = sim.time();
+        io::SnapshotLayout layout = io::write_snapshot(file, sim.particles(), info);
+        folder_.claim(snapshots_.path());
+        snapshots_.add(name, std::move(layout));
       } else {
         file = folder_.claim(dir_ / fmt::format("particles_{:06d}.csv", frames_));
         io::write_csv(file, sim.particles(), sim.time());
@@ -92,9 +113,28 @@ class FrameWriter final : public Observer<Real> {
     if (on_frame_) on_frame_(first, sim.time(), [this](const std::filesystem::path& p) { return folder_.claim(p); });
   }
 
+  static std::string snapshot_name(std::size_t frame) { return fmt::format("particles_{:06d}.h5", frame); }
+  bool has(scene::OutputFormat format) const {
+    return std::find(formats_.begin(), formats_.end(), format) != formats_.end();
+  }
+  // What every snapshot of this scene says beside its particles (the time is the frame's).
+  static io::SnapshotInfo snapshot_info(const scene::Scene& scene) {
+    io::SnapshotInfo info;
+    info.type = scene.sph ? io::PartType::Gas : io::PartType::Collisionless;
+    if (scene.walls) {
+      const Vec3d e = scene.box.extent();
+      info.box_size = std::max({e.x, e.y, e.z});
+    }
+    info.si_units = scene.units == scene::Units::SI;
+    info.gravitational_constant = scene.gravitational_constant;
+    return info;
+  }
+
   std::vector<scene::OutputFormat> formats_;
   std::filesystem::path dir_;
   io::PvdSeries series_;
+  io::XdmfSeries snapshots_;
+  io::SnapshotInfo snapshot_info_;
   IntervalSchedule schedule_;
   FrameHook on_frame_;
   io::RunFolder& folder_;

@@ -160,9 +160,9 @@ TEST(SceneErrors, UnknownNamesListTheAllowedOnes) {
            {"precision", full("precision = \"double\"", "precision = \"single\""),
             "simulation.precision: unknown precision 'single' (allowed: 'float', 'double')"},
            {"format", full("format = [\"csv\", \"vtp\"]", "format = \"xml\""),
-            "output.format: unknown format 'xml' (allowed: 'vtp', 'csv')"},
+            "output.format: unknown format 'xml' (allowed: 'vtp', 'csv', 'hdf5')"},
            {"format in array", full("format = [\"csv\", \"vtp\"]", "format = [\"csv\", \"VTP\"]"),
-            "output.format[1]: unknown format 'VTP' (allowed: 'vtp', 'csv')"},
+            "output.format[1]: unknown format 'VTP' (allowed: 'vtp', 'csv', 'hdf5')"},
        }) {
     expect_error(c);
   }

@@ -1,5 +1,6 @@
 // One frame of a run as the renderer needs it: positions, time and the fields
-// it can colour by, converted to double from a .vtp file (io/vtp.hpp).
+// it can colour by, converted to double from a .vtp file (io/vtp.hpp) or an
+// HDF5 snapshot (.h5, io/snapshot.hpp).
 #pragma once
 
 #include <filesystem>
@@ -24,8 +25,8 @@ struct Frame {
   std::vector<double> mass, density, pressure;
 };
 
-// Reads a .vtp frame. Throws io::IoError naming the file for a missing,
-// truncated or corrupt file, or a field of the wrong shape.
+// Reads a .vtp or .h5 frame (by extension). Throws io::IoError naming the
+// file for a missing, truncated or corrupt file, or a field of the wrong shape.
 Frame load_frame(const std::filesystem::path& file);
 
 // The value of `q` per particle (speed = |velocity|). Throws io::IoError

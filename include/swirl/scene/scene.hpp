@@ -29,13 +29,14 @@
 namespace swirl::scene {
 
 enum class Precision { Float, Double };
-enum class OutputFormat { Vtp, Csv };
+enum class OutputFormat { Vtp, Csv, Hdf5 };
 // The unit system of a scene's numbers: SI (m, s, kg; G = 6.67430e-11
 // m³ kg⁻¹ s⁻²) or N-body units (G = 1, Hénon units for the stellar models).
 enum class Units { SI, NBody };
 
 inline constexpr std::array<EnumName<Precision>, 2> kPrecisionNames{{{"float", Precision::Float}, {"double", Precision::Double}}};
-inline constexpr std::array<EnumName<OutputFormat>, 2> kOutputFormatNames{{{"vtp", OutputFormat::Vtp}, {"csv", OutputFormat::Csv}}};
+inline constexpr std::array<EnumName<OutputFormat>, 3> kOutputFormatNames{
+    {{"vtp", OutputFormat::Vtp}, {"csv", OutputFormat::Csv}, {"hdf5", OutputFormat::Hdf5}}};
 inline constexpr std::array<EnumName<Units>, 2> kUnitsNames{{{"si", Units::SI}, {"nbody", Units::NBody}}};
 
 // The gravitational constant in SI units, m³ kg⁻¹ s⁻² (CODATA 2018).
@@ -137,7 +138,7 @@ struct Scene {
   double damping = 0;                      // forces.damping, 1/s, ≥ 0: a drag a = −damping·v (settling runs)
 
   double output_interval = 0;              // output.interval, s of simulated time; 0 = first and last frame only
-  std::vector<OutputFormat> formats{OutputFormat::Vtp};  // output.format: "vtp" and/or "csv"
+  std::vector<OutputFormat> formats{OutputFormat::Vtp};  // output.format: "vtp", "csv" and/or "hdf5"
 
   std::vector<ParticleSource> sources;     // [[particles]]; a "fluid_block" becomes a LatticeSource
                                            // whose mass gives the rest density (sph::lattice_mass_for_density)

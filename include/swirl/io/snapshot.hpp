@@ -1,0 +1,114 @@
+// HDF5 snapshots: one frame per file, in the layout the Gadget-format HDF5
+// codes share (Gadget-2/4, AREPO and SWIFT write it; yt, pynbody and the
+// community's initial-condition generators read or write it), so swirl's
+// frames open in those tools and their files can be read back here.
+//
+// Layout (format version kSnapshotVersion):
+//   /Header                attributes: NumPart_ThisFile, NumPart_Total,
+//                          NumPart_Total_HighWord (6 × uint32, the count in the
+//                          particle type's slot), MassTable (6 × double, all 0:
+//                          masses are per particle), Time, Redshift (0),
+//                          BoxSize (the box's largest side; 0 without walls),
+//                          NumFilesPerSnapshot (1), Flag_DoublePrecision;
+//                          swirl's own: SwirlFormatVersion, UnitSystem ("si" |
+//                          "nbody"), GravitationalConstant (in the run's units).
+//   /Units                 SI runs only, SWIFT's attribute names: "Unit length
+//                          in cgs (U_L)" = 100, mass (U_M) = 1000, time (U_t) =
+//                          1, current (U_I) = 1, temperature (U_T) = 1.
+//   /PartType<k>           k = 0 for SPH fluid, 1 for collisionless particles
+//                          (stars, dark matter): datasets Coordinates (N × 3),
+//                          Velocities (N × 3), Masses (N), ParticleIDs (N,
+//                          uint64), then every other output field of the
+//                          ParticleSet (the built-ins by their Gadget names:
+//                          Accelerations, Density, Pressure; the others, e.g.
+//                          potential, by their own names), real fields in the
+//                          run's precision, integer fields as int32; each with
+//                          an attribute "units" naming its unit in words.
+// Datasets are chunked and deflated (with the shuffle filter); object times are
+// not recorded, so the same state gives the same bytes.
+//
+// Reading accepts any file with that layout (one particle type, masses either
+// per particle or from MassTable) and refuses anything else with an IoError
+// naming the file and the group, dataset or attribute, and the reason:
+// missing, wrong shape or type, a count that disagrees with the header, a value
+// that is not finite.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "swirl/core/particle_set.hpp"
+
+namespace swirl::io {
+
+inline constexpr int kSnapshotVersion = 1;
+
+// Gadget's particle types that swirl writes.
+enum class PartType : int { Gas = 0, Collisionless = 1 };
+
+// What a snapshot says beside its particles.
+struct SnapshotInfo {
+  double time = 0;
+  PartType type = PartType::Gas;
+  double box_size = 0;          // the box's largest side (0: no walls)
+  bool si_units = true;         // false: N-body units (G = 1 by default)
+  double gravitational_constant = 6.6743e-11;
+};
+
+// What a snapshot file holds, without its values: enough to describe it to
+// ParaView (io/xdmf.hpp).
+struct SnapshotLayout {
+  struct Dataset {
+    std::string name;      // in /PartType<k>
+    int components = 1;    // columns
+    bool integer = false;  // stored as an integer type
+    bool is_unsigned = false;  // an unsigned integer (ParticleIDs)
+    int bytes = 8;         // bytes per value
+  };
+  double time = 0;
+  PartType type = PartType::Gas;
+  std::size_t count = 0;
+  std::vector<Dataset> datasets;  // in file order: Coordinates, Velocities, Masses, ParticleIDs, ...
+};
+
+// Writes one frame atomically (built in memory, then io::write_file_atomic)
+// and returns what it wrote.
+template <class Real>
+SnapshotLayout write_snapshot(const std::filesystem::path& path, const ParticleSet<Real>& particles,
+                              const SnapshotInfo& info);
+
+extern template SnapshotLayout write_snapshot<float>(const std::filesystem::path&, const ParticleSet<float>&,
+                                                     const SnapshotInfo&);
+extern template SnapshotLayout write_snapshot<double>(const std::filesystem::path&, const ParticleSet<double>&,
+                                                      const SnapshotInfo&);
+
+// The layout of a snapshot file, from its header and dataset shapes only (no
+// values read). Throws IoError as read_snapshot does for what it looks at.
+SnapshotLayout read_snapshot_layout(const std::filesystem::path& path);
+
+// One dataset read back: `columns` values per particle, row by row, in double
+// (integer datasets converted exactly below 2⁵³).
+struct SnapshotDataset {
+  std::size_t columns = 1;
+  bool integer = false;       // stored as an integer type
+  std::string units;          // its "units" attribute, if any
+  std::vector<double> values;  // rows × columns
+};
+
+struct SnapshotFile {
+  SnapshotInfo info;
+  int version = 0;                         // SwirlFormatVersion; 0 for files from other codes
+  std::size_t count = 0;                   // particles of the one type present
+  std::vector<std::uint64_t> ids;          // ParticleIDs (0..count−1 when absent)
+  std::map<std::string, SnapshotDataset> datasets;  // by name; Coordinates, Velocities, Masses always present
+};
+
+// Reads a snapshot (see the header comment). Throws IoError.
+SnapshotFile read_snapshot(const std::filesystem::path& path);
+
+}  // namespace swirl::io
