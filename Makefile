@@ -62,13 +62,14 @@ unit-test: build
 # The Python module (python/, docs/python.md), built by `pip install .` into a
 # venv of Debian's Python (/usr/bin/python3 with its numpy and matplotlib; the
 # python3 on PATH may be another): build-python/venv, CMake tree in
-# build-python/build (position-independent libraries; the CLI's trees are untouched).
+# build-python/build (position-independent libraries; the CLI's trees are untouched),
+# with the release preset's -march=native, so its results are the release CLI's bit for bit.
 PY_VENV := build-python/venv
 python: deps
 	@[ -x $(PY_VENV)/bin/python ] || /usr/bin/python3 -m venv --system-site-packages $(PY_VENV)
 	$(PY_VENV)/bin/pip install -q -r python/requirements-dev.txt
 	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PY_VENV)/bin/pip install -q --no-build-isolation \
-	  --config-settings=build-dir=build-python/build $(if $(shell command -v ccache),--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache) .
+	  --config-settings=build-dir=build-python/build --config-settings=cmake.define.SWIRL_NATIVE=ON $(if $(shell command -v ccache),--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache) .
 
 # pytest on the installed module; the CLI of `make build` is the reference of
 # the byte-identical frames test.

@@ -11,6 +11,9 @@ if(NOT SWIRL_NANOBIND_FOUND EQUAL 0)
   message(FATAL_ERROR "SWIRL_BUILD_PYTHON: nanobind is not installed for ${Python_EXECUTABLE} "
                       "(pip install -r python/requirements-build.txt, or build with `pip install .`)")
 endif()
+# The nanobind of this configure's environment (pip's isolated build
+# environment is a new directory each time: a cached one may be gone).
+unset(nanobind_DIR CACHE)
 find_package(nanobind CONFIG REQUIRED PATHS "${SWIRL_NANOBIND_DIR}" NO_DEFAULT_PATH)
 
 # The static libraries go into a shared module: position-independent code, in

@@ -1,0 +1,94 @@
+"""Run folders as the CLI makes them: byte-identical frames, resume, Ctrl-C with a checkpoint."""
+
+import filecmp
+import os
+import signal
+import subprocess
+import threading
+
+import pytest
+
+from conftest import EXAMPLES, SPH_OVERRIDES, cli_path
+
+STEPS = 20  # frames at steps 0, 10, 20 (output.interval = 0.004 s, dt = 4e-4 s)
+
+
+def cli_run(tmp_path, *args):
+    cli = cli_path()
+    if cli is None:
+        pytest.skip("no swirl CLI to compare with (make python-test sets SWIRL_CLI)")
+    out = tmp_path / "cli"
+    sets = [a for o in SPH_OVERRIDES for a in ("--set", o)]
+    subprocess.run([cli, "run", str(EXAMPLES / "dam_break.toml"), *sets, "--out", str(out), *args],
+                   check=True, capture_output=True)
+    return out
+
+
+def test_frames_byte_identical_to_the_cli(swirl, tmp_path):
+    cli = cli_run(tmp_path, "--steps", str(STEPS))
+    scene = swirl.Scene.from_file(EXAMPLES / "dam_break.toml", overrides=SPH_OVERRIDES)
+
+    # The run loop, from Python.
+    out = tmp_path / "py"
+    summary = swirl.run(scene, out, steps=STEPS)
+    assert summary["error"] == "" and summary["steps"] == STEPS and summary["frames"] == 3
+    names = sorted(p.name for p in cli.iterdir() if p.name.startswith("particles") or p.name == "diagnostics.csv")
+    assert "particles_000002.vtp" in names and "particles.pvd" in names
+    for name in names + ["scene.toml"]:
+        assert filecmp.cmp(cli / name, out / name, shallow=False), name
+
+    # A Simulation stepped from Python, its frame written by the same writer.
+    sim = swirl.Simulation(scene)
+    sim.write_frame(tmp_path / "step0.vtp")
+    sim.run(steps=STEPS)
+    sim.write_frame(tmp_path / "step20.vtp")
+    assert filecmp.cmp(cli / "particles_000000.vtp", tmp_path / "step0.vtp", shallow=False)
+    assert filecmp.cmp(cli / "particles_000002.vtp", tmp_path / "step20.vtp", shallow=False)
+
+
+def test_summary_and_diagnostics(swirl, sph_scene, tmp_path):
+    out = tmp_path / "run"
+    summary = swirl.run(sph_scene, out, steps=10, threads=1)
+    assert summary["threads"] == 1 and summary["particles"] == sph_scene.particle_count
+    assert summary["phases"]["forces"] > 0 and "mean_neighbours" in summary["metrics"]
+    d = swirl.read_diagnostics(out)
+    assert d["time"].tolist()[0] == 0.0 and len(d["time"]) == 2
+    assert "kinetic_energy" in d
+    with pytest.raises(swirl.IoError, match="another run|holds"):
+        swirl.run(sph_scene, out, steps=10)
+    assert swirl.run(sph_scene, out, steps=10, overwrite=True)["steps"] == 10
+
+
+def test_resume_is_bit_identical(swirl, sph_scene, tmp_path):
+    whole = tmp_path / "whole"
+    swirl.run(sph_scene, whole, steps=20)
+    part = tmp_path / "part"
+    first = swirl.run(sph_scene, part, steps=10, checkpoint_every_steps=5)
+    assert first["last_checkpoint"].endswith("checkpoint_000000000010.swc")
+    second = swirl.resume(part, steps=10)
+    assert second["first_step"] == 10 and second["steps"] == 10
+    assert filecmp.cmp(whole / "particles_000002.vtp", part / "particles_000002.vtp", shallow=False)
+
+
+def test_ctrl_c_stops_the_run_with_a_checkpoint(swirl, sph_scene, tmp_path):
+    out = tmp_path / "run"
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            swirl.run(sph_scene, out, steps=10**6)
+    finally:
+        timer.cancel()
+    assert list((out / "checkpoints").glob("*.swc"))
+    assert swirl.resume(out, steps=2)["steps"] == 2
+
+
+def test_progress_callback_can_stop(swirl, sph_scene, tmp_path):
+    seen = []
+
+    def progress(p):
+        seen.append(p["step"])
+        return p["step"] < 3
+
+    summary = swirl.run(sph_scene, tmp_path / "run", steps=50, progress=progress)
+    assert summary["interrupted"] and summary["steps"] == 3 and seen[-1] == 3
