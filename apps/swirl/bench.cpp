@@ -4,7 +4,7 @@
 //   swirl bench hash-stats [--particles 15000] [--neighbours 25] [--buckets 24001] [--settle 500] [--steps N]
 //   swirl bench bh-table   [--sizes 1024,...,32768] [--schemes ...] [--iterations 50] [--opening 0.5]
 //   swirl bench bh-lambda  [--sizes 4096,32768] [--lambdas 0.3,0.5,0.7,0.9] [--schemes ...] [--iterations 20]
-//   swirl bench bh-phases  [--sizes ...] [--schemes subtree] [--iterations 50] [--opening 0.5]
+//   swirl bench bh-phases  [--sizes ...] [--schemes subtree,subtree+paper] [--iterations 50] [--opening 0.5]
 //   swirl bench bh-opt     [--sizes 1024,...,32768] [--schemes subtree,subdomain] [--iterations N] [--rounds 3]
 //                          [--opening 0.5] [--bin-dir DIR]
 // and on every suite: --out DIR (default bench/results/<suite>), --threads 1,2 (default 1 .. all), --quick.

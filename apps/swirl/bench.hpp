@@ -142,7 +142,7 @@ struct BhLambdaArgs {
 };
 struct BhPhasesArgs {
   std::vector<std::size_t> sizes{1024, 2048, 4096, 8192, 16384, 32768};
-  std::vector<std::string> schemes{"subtree"};
+  std::vector<std::string> schemes{"subtree", "subtree+paper"};
   int iterations = 50;
   double opening = 0.5;
 };
