@@ -29,7 +29,8 @@ nanobind_add_module(_swirl NB_STATIC
   ${PROJECT_SOURCE_DIR}/python/src/module.cpp
   ${PROJECT_SOURCE_DIR}/python/src/scene.cpp
   ${PROJECT_SOURCE_DIR}/python/src/simulation.cpp
-  ${PROJECT_SOURCE_DIR}/python/src/run.cpp)
+  ${PROJECT_SOURCE_DIR}/python/src/run.cpp
+  ${PROJECT_SOURCE_DIR}/python/src/render.cpp)
 target_link_libraries(_swirl PRIVATE swirl::swirl)
 # swirl's warnings (errors) on the binding sources; nanobind's and Python's
 # headers as system headers (GCC drops a -I for a directory also given with -isystem).

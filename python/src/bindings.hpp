@@ -6,6 +6,7 @@
 //                   with the GIL released, its fields as zero-copy numpy arrays
 //   run.cpp         sim::run_scene (frames, diagnostics, checkpoints, resume) as
 //                   `swirl run` calls it, and the summary as a dict
+//   render.cpp      a run folder's frame drawn as `swirl render` draws it
 #pragma once
 
 #include <nanobind/nanobind.h>
@@ -24,6 +25,7 @@ struct PyScene {
 void bind_scene(nb::module_& m);
 void bind_simulation(nb::module_& m);
 void bind_run(nb::module_& m);
+void bind_render(nb::module_& m);
 
 // Raises KeyboardInterrupt (or whatever a signal handler raised) if a signal
 // arrived. Call with the GIL held, between steps.

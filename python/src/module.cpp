@@ -28,6 +28,7 @@ NB_MODULE(_swirl, m) {
   bind_scene(m);
   bind_simulation(m);
   bind_run(m);
+  bind_render(m);
 }
 
 }  // namespace swirl::python

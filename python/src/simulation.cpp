@@ -24,7 +24,9 @@
 #include <fmt/format.h>
 #include <nanobind/ndarray.h>
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
 #include <nanobind/stl/unique_ptr.h>
 
 #include "bindings.hpp"
@@ -37,10 +39,41 @@
 namespace swirl::python {
 namespace {
 
+// A force written in Python: a Solver whose add_acceleration() takes the GIL
+// and calls fn(t) (python/swirl/_simulation.py wraps the user's f(sim, t)),
+// which adds to the acceleration fields through fresh views: the particle
+// order was brought up to date before the solvers run. Timed as the phase
+// "forces.<name>" (its cost, in Simulation.phases()). Energy: unknown, so a
+// run with one reports no relative energy error.
+template <class Real>
+class PythonForce final : public Solver<Real> {
+ public:
+  PythonForce(std::string name, nb::object fn) : name_(std::move(name)), phase_("forces." + name_), fn_(std::move(fn)) {}
+  ~PythonForce() override {
+    nb::gil_scoped_acquire gil;
+    fn_.reset();
+  }
+  std::string_view name() const override { return name_; }
+  void add_acceleration(ParticleSet<Real>&, const SolverContext<Real>& ctx) override {
+    std::optional<ScopedPhase> phase;
+    if (ctx.timers) phase.emplace(*ctx.timers, phase_);
+    nb::gil_scoped_acquire gil;
+    fn_(ctx.time);
+  }
+  bool conserves_energy() const override { return false; }
+
+ private:
+  std::string name_, phase_;
+  nb::object fn_;
+};
+
+using Forces = std::vector<std::pair<std::string, nb::object>>;
+
 // What Python sees of a Simulation<Real>, whichever Real.
 class AnySimulation {
  public:
   virtual ~AnySimulation() = default;
+  virtual void start() = 0;
   virtual void step(std::optional<double> land_at) = 0;
   virtual double time() const = 0;
   virtual std::uint64_t steps() const = 0;
@@ -67,12 +100,18 @@ class AnySimulation {
 template <class Real>
 class TypedSimulation final : public AnySimulation {
  public:
-  TypedSimulation(const scene::Scene& scene, bool walls, double restitution)
-      : sim_(sim::build_simulation<Real>(scene)), block_size_(scene.block_size) {
+  TypedSimulation(const scene::Scene& scene, const Forces& forces)
+      : sim_(sim::build_simulation<Real>(scene)), block_size_(scene.block_size), walls_(scene.walls),
+        restitution_(scene.restitution) {
+    for (const auto& [name, fn] : forces) sim_.add_solver(std::make_unique<PythonForce<Real>>(name, fn));
+  }
+
+  // The initial forces; once, before anything else (the Python object exists by then, for the forces).
+  void start() override {
     sim_.start();
     conservative_ = std::all_of(sim_.solvers().begin(), sim_.solvers().end(),
                                 [](const auto& s) { return s->conserves_energy(); }) &&
-                    (!walls || restitution == 1);
+                    (!walls_ || restitution_ == 1);
     initial_energy_ = energies().total;
   }
 
@@ -213,14 +252,15 @@ class TypedSimulation final : public AnySimulation {
 
   Simulation<Real> sim_;
   std::size_t block_size_;
+  bool walls_;
+  double restitution_;
   bool conservative_ = true;
   double initial_energy_ = 0;
 };
 
-std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene) {
-  if (scene.precision == scene::Precision::Float)
-    return std::make_unique<TypedSimulation<float>>(scene, scene.walls, scene.restitution);
-  return std::make_unique<TypedSimulation<double>>(scene, scene.walls, scene.restitution);
+std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene, const Forces& forces) {
+  if (scene.precision == scene::Precision::Float) return std::make_unique<TypedSimulation<float>>(scene, forces);
+  return std::make_unique<TypedSimulation<double>>(scene, forces);
 }
 
 // The Python-facing object: the simulation and the stepping loops.
@@ -230,13 +270,16 @@ class PySimulation {
 
   AnySimulation& sim() { return *sim_; }
 
+  void start() {
+    if (started_) return;
+    sim_->start();
+    started_ = true;
+  }
+
   // n steps; signals (Ctrl-C) are checked after each one.
   void step(std::uint64_t n) {
     for (std::uint64_t k = 0; k < n; ++k) {
-      {
-        nb::gil_scoped_release release;
-        sim_->step(std::nullopt);
-      }
+      one_step(std::nullopt);
       check_signals();
     }
   }
@@ -264,10 +307,7 @@ class PySimulation {
         if (until) land = until;
         if (const auto t = schedule.next_time(); t && (!land || *t < *land)) land = t;
       }
-      {
-        nb::gil_scoped_release release;
-        sim_->step(land);
-      }
+      one_step(land);
       check_signals();
       bool due = every_steps && (sim_->steps() - first) % *every_steps == 0;
       if (schedule.due(sim_->time())) {
@@ -283,7 +323,25 @@ class PySimulation {
   }
 
  private:
+  // One step with the GIL released. A Python force that raised left the
+  // state between a drift and a kick: the simulation refuses to go on.
+  void one_step(std::optional<double> land) {
+    if (!broken_.empty()) throw std::runtime_error(broken_);
+    if (!started_) throw std::logic_error("the simulation was not started (swirl.Simulation starts it)");
+    try {
+      nb::gil_scoped_release release;
+      sim_->step(land);
+    } catch (nb::python_error&) {
+      broken_ = fmt::format("a Python force raised during step {} (t = {:.6g}), leaving the state inside that step; "
+                            "this simulation cannot go on: build a new one",
+                            sim_->steps() + 1, sim_->time());
+      throw;
+    }
+  }
+
   std::unique_ptr<AnySimulation> sim_;
+  bool started_ = false;
+  std::string broken_;
 };
 
 // One row of a (n, 3) or (n,) array of doubles, checked finite.
@@ -301,7 +359,7 @@ using Column = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::
 // The scene's physics with these particles instead of its [[particles]]:
 // one list source, validated as a scene file's list is.
 std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, std::optional<Rows> velocities,
-                                           Column masses) {
+                                           Column masses, const Forces& forces) {
   const std::size_t n = positions.shape(0);
   if (positions.shape(1) != 3) throw nb::value_error("positions must have shape (n, 3)");
   if (velocities && (velocities->shape(0) != n || velocities->shape(1) != 3))
@@ -329,7 +387,7 @@ std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, 
   s.file = (base.scene.file.empty() ? std::string("scene") : base.scene.file) + " (particles from arrays)";
   scene::validate(s);
   nb::gil_scoped_release release;
-  return make_simulation(s);
+  return make_simulation(s, forces);
 }
 
 }  // namespace
@@ -337,22 +395,27 @@ std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, 
 void bind_simulation(nb::module_& m) {
   nb::class_<PySimulation>(m, "Simulation")
       .def("__init__",
-           [](PySimulation* self, const PyScene& s) {
+           [](PySimulation* self, const PyScene& s, const Forces& forces) {
              std::unique_ptr<AnySimulation> sim;
              {
                nb::gil_scoped_release release;
-               sim = make_simulation(s.scene);
+               sim = make_simulation(s.scene, forces);
              }
              new (self) PySimulation(std::move(sim));
            },
-           nb::arg("scene"))
+           nb::arg("scene"), nb::arg("forces"))
       .def_static(
           "from_arrays",
-          [](const PyScene& s, Rows positions, std::optional<Rows> velocities, Column masses) {
-            return new PySimulation(from_arrays(s, positions, velocities, masses));
+          [](const PyScene& s, Rows positions, std::optional<Rows> velocities, Column masses, const Forces& forces) {
+            return new PySimulation(from_arrays(s, positions, velocities, masses, forces));
           },
           nb::arg("scene"), nb::arg("positions").noconvert(), nb::arg("velocities").noconvert().none(),
-          nb::arg("masses").noconvert(), nb::rv_policy::take_ownership)
+          nb::arg("masses").noconvert(), nb::arg("forces"), nb::rv_policy::take_ownership)
+      .def("start",
+           [](PySimulation& s) {
+             nb::gil_scoped_release release;
+             s.start();
+           })
       .def("step", &PySimulation::step, nb::arg("n"))
       .def("run", &PySimulation::run, nb::arg("until").none(), nb::arg("steps").none(), nb::arg("every_time").none(),
            nb::arg("every_steps").none(), nb::arg("callback").none())

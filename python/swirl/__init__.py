@@ -16,6 +16,7 @@ Names:
                      the particle fields as zero-copy numpy views, checked against reordering
     run, resume      runs into a run folder as ``swirl run`` (frames, diagnostics, checkpoints)
     read_diagnostics a run folder's diagnostics.csv as numpy arrays
+    render           a run folder's frame as an RGB numpy image (and a PNG), as ``swirl render``
     set_threads, threads
     SceneError (ValueError), SimulationError (RuntimeError), IoError (OSError), StaleViewError (RuntimeError)
 
@@ -23,7 +24,7 @@ docs/python.md in the repository is the full page.
 """
 
 from . import _swirl
-from ._run import read_diagnostics, resume, run
+from ._run import read_diagnostics, render, resume, run
 from ._scene import Scene
 from ._simulation import Simulation
 from ._views import FieldArray, Particles, StaleViewError, VectorField
@@ -52,5 +53,5 @@ def threads():
     return _swirl.thread_count()
 
 
-__all__ = ["Scene", "Simulation", "Particles", "VectorField", "FieldArray", "run", "resume", "read_diagnostics",
+__all__ = ["Scene", "Simulation", "Particles", "VectorField", "FieldArray", "run", "resume", "read_diagnostics", "render",
            "set_threads", "threads", "SceneError", "SimulationError", "IoError", "StaleViewError", "__version__"]

@@ -99,3 +99,29 @@ def read_diagnostics(run_dir):
         column = [r[k] for r in body]
         out[name] = np.array(column) if name == "limited_by" else np.array(column, dtype=np.float64)
     return out
+
+
+def render(run_dir, frame=-1, *, view="front", color=None, size=(1280, 720), range=None, projection=None, png=None):
+    """Draws frame ``frame`` of a run folder as ``swirl render`` does; returns an (height, width, 3) uint8 RGB image.
+
+    ``frame``: the frame's number (negative counts from the end; default the
+    last). ``view``: ``"front"``, ``"top"`` or ``"iso"``; ``color``:
+    ``"speed"``, ``"density"``, ``"pressure"`` or ``"mass"`` (default: density
+    for gravity runs, else speed); ``size``: (width, height) in pixels, each
+    >= 64; ``range``: (lo, hi) colour range (log10 surface density for the
+    gravity density view), default from the run's first frame, as the CLI;
+    ``projection``: ``"ortho"`` or ``"perspective"`` (default: perspective for
+    iso). ``png``: also write the picture there (the CLI's PNG bytes).
+    """
+    if isinstance(frame, bool) or not isinstance(frame, numbers.Integral):
+        raise ValueError(f"frame={frame!r}: give a frame number")
+    try:
+        width, height = (int(x) for x in size)
+    except (TypeError, ValueError):
+        raise ValueError(f"size={size!r}: give (width, height) in pixels") from None
+    if range is not None:
+        lo, hi = (float(x) for x in range)
+        range = (lo, hi)
+    result = _swirl.render_frame(os.fspath(run_dir), int(frame), view, projection, color, width, height, range,
+                                 None if png is None else os.fspath(png))
+    return result["image"]

@@ -2,6 +2,7 @@
 
 import numbers
 import os
+import weakref
 
 import numpy as np
 
@@ -30,6 +31,37 @@ def _check_array(name, a, ndim, n=None):
     return np.asarray(a, dtype=np.float64)
 
 
+def _forces(sim, forces):
+    """(name, fn(t)) pairs for the engine from the user's forces: dict name -> f, or a list of callables."""
+    if forces is None:
+        return []
+    if callable(forces):
+        forces = [forces]
+    if isinstance(forces, dict):
+        items = forces.items()
+    else:  # named by __name__; a lambda by its place
+        items = []
+        for k, f in enumerate(forces):
+            name = getattr(f, "__name__", "")
+            items.append((name if isinstance(name, str) and name.isidentifier() else f"force{k}", f))
+    ref = weakref.ref(sim)  # no cycle between the engine's force and this object
+    out, seen = [], set()
+    for name, f in items:
+        if not isinstance(name, str) or not name.isidentifier():
+            raise ValueError(f"force name {name!r}: give a Python identifier (it names the phase forces.python.<name>)")
+        if name in seen:
+            raise ValueError(f"two forces named {name!r}: give them different names (a dict name -> function)")
+        if not callable(f):
+            raise TypeError(f"force {name!r} is not callable as f(sim, t)")
+        seen.add(name)
+
+        def call(t, f=f):
+            f(ref(), t)
+
+        out.append((f"python.{name}", call))
+    return out
+
+
 class Simulation:
     """A running simulation of a scene: particles, solvers, stepper and clock.
 
@@ -53,20 +85,35 @@ class Simulation:
     A blow-up (a non-finite state, a particle leaving the box, a step beyond
     the stability condition) raises ``swirl.SimulationError`` naming the
     step, the particle and a fix, as the CLI reports it.
+
+    ``forces``: forces written in Python, added after the scene's: a dict
+    ``{name: f}`` or a list of functions (named by ``__name__``, a lambda
+    ``force<k>`` by its place). The engine
+    calls ``f(sim, t)`` at every force evaluation (once per step, and once
+    for the initial state), once the accelerations were zeroed and the scene's
+    own solvers have added theirs: ``f`` adds its
+    acceleration (m/s², or N-body units) into ``sim.particles.acceleration``
+    (``.x += ...``: vectorised over numpy views, which are fresh there) at
+    time ``t`` (the positions' time). Its cost is the phase
+    ``forces.python.<name>`` of ``sim.phases()`` (seconds). Energy is then
+    not known to be conserved (no relative energy error). An exception in
+    ``f`` propagates and leaves the simulation unusable (the state is inside
+    a step).
     """
 
     __slots__ = ("_native", "_scene", "__weakref__")
 
-    def __init__(self, scene):
+    def __init__(self, scene, forces=None):
         if isinstance(scene, (str, os.PathLike)):
             scene = Scene.from_file(scene)
         if not isinstance(scene, Scene):
             raise TypeError(f"Simulation(scene): give a swirl.Scene or a scene file path, not a {type(scene).__name__}")
         self._scene = scene
-        self._native = _swirl.Simulation(scene._scene)
+        self._native = _swirl.Simulation(scene._scene, _forces(self, forces))
+        self._native.start()
 
     @classmethod
-    def from_arrays(cls, scene, positions, velocities=None, masses=None):
+    def from_arrays(cls, scene, positions, velocities=None, masses=None, forces=None):
         """A simulation of the scene's physics with these particles instead of its ``[[particles]]``.
 
         ``positions``: (n, 3) array (m, or N-body length); ``velocities``:
@@ -78,7 +125,7 @@ class Simulation:
         ``kind = "list"`` source is (inside the box, ...): ``SceneError``.
         The fields are stored in the scene's precision (``scene.precision``)
         whatever the arrays' dtype. Every other setting (dt, solvers, box,
-        output) is the scene's.
+        output) is the scene's. ``forces``: as for ``Simulation()``.
         """
         if isinstance(scene, (str, os.PathLike)):
             scene = Scene.from_file(scene)
@@ -99,7 +146,8 @@ class Simulation:
             mass = _check_array("masses", masses, 1, n)
         self = cls.__new__(cls)
         self._scene = scene
-        self._native = _swirl.Simulation.from_arrays(scene._scene, pos, vel, mass)
+        self._native = _swirl.Simulation.from_arrays(scene._scene, pos, vel, mass, _forces(self, forces))
+        self._native.start()
         return self
 
     # -- stepping ----------------------------------------------------------

@@ -163,23 +163,28 @@ class VectorField:
         self._sim = sim
         self._name = name
 
-    @property
-    def x(self):
-        """Component 0 (zero-copy, checked view)."""
-        return FieldArray(self._sim, self._name, 0, vector=True)
+    def _get(self, axis):
+        return FieldArray(self._sim, self._name, axis, vector=True)
 
-    @property
-    def y(self):
-        """Component 1 (zero-copy, checked view)."""
-        return FieldArray(self._sim, self._name, 1, vector=True)
+    def _set(self, axis, value):
+        # `v.x += a` hands back the view itself (already written in place); anything else is written into it.
+        if isinstance(value, FieldArray) and value._name == self._name and value._component == axis:
+            value._check()
+            return
+        self._get(axis)[:] = value
 
-    @property
-    def z(self):
-        """Component 2 (zero-copy, checked view)."""
-        return FieldArray(self._sim, self._name, 2, vector=True)
+    x = property(lambda self: self._get(0), lambda self, v: self._set(0, v),
+                 doc="Component 0 (zero-copy, checked view); assigning writes every particle's value.")
+    y = property(lambda self: self._get(1), lambda self, v: self._set(1, v),
+                 doc="Component 1 (zero-copy, checked view); assigning writes every particle's value.")
+    z = property(lambda self: self._get(2), lambda self, v: self._set(2, v),
+                 doc="Component 2 (zero-copy, checked view); assigning writes every particle's value.")
 
     def __getitem__(self, axis):
-        return FieldArray(self._sim, self._name, axis, vector=True)
+        return self._get(axis)
+
+    def __setitem__(self, axis, value):
+        self._set(axis, value)
 
     def to_numpy(self):
         """An (n, 3) copy in storage order (row i is the particle at index i now)."""

@@ -1,0 +1,81 @@
+// Pictures of a run folder's frames, as `swirl render` draws them
+// (render/run_renderer.hpp): one frame to an (height, width, 3) uint8 numpy
+// image, and to a PNG when asked. The camera and colours are fixed from the
+// run's first frame, as for the CLI, so pictures of one run match each other
+// and the CLI's.
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nanobind/ndarray.h>
+#include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
+#include <nanobind/stl/string.h>
+
+#include "bindings.hpp"
+#include "swirl/io/atomic_file.hpp"
+#include "swirl/render/frame.hpp"
+#include "swirl/render/png.hpp"
+#include "swirl/render/run_renderer.hpp"
+
+namespace swirl::python {
+namespace {
+
+nb::dict render_frame(const std::string& run_dir, int frame, const std::string& view,
+                      const std::optional<std::string>& projection, const std::optional<std::string>& color, int width,
+                      int height, std::optional<std::pair<double, double>> range, const std::optional<std::string>& png) {
+  render::RenderOptions options;
+  options.view = render::parse_view(view);
+  if (projection) options.projection = render::parse_projection(*projection);
+  if (color) options.color = render::parse_quantity(*color);
+  if (width < 64 || height < 64)
+    throw nb::value_error(fmt::format("size {}x{}: each side must be at least 64 pixels", width, height).c_str());
+  options.width = width, options.height = height;
+  options.range = range;
+  std::vector<std::uint8_t> rgb;
+  std::pair<double, double> used{};
+  std::string quantity, file;
+  double time = 0;
+  {
+    nb::gil_scoped_release release;
+    render::RunInfo run = render::read_run(run_dir);
+    const auto count = static_cast<int>(run.frames.size());
+    const int k = frame < 0 ? count + frame : frame;
+    if (k < 0 || k >= count)
+      throw std::out_of_range(fmt::format("{}: no frame {} (the run has frames 0 to {})", run_dir, frame, count - 1));
+    const std::filesystem::path vtp = std::filesystem::path(run_dir) / run.frames[static_cast<std::size_t>(k)].file;
+    const render::RunRenderer renderer(std::move(run), options);
+    const render::Frame f = render::load_frame(vtp);
+    const render::Image image = renderer.render(f);
+    if (png) render::write_png(*png, image);
+    rgb = render::to_rgb8(image);
+    used = renderer.range();
+    quantity = renderer.log_density_view() ? "log10 surface density" : std::string(render::quantity_name(renderer.quantity()));
+    file = vtp.string();
+    time = f.time;
+  }
+  auto* owned = new std::vector<std::uint8_t>(std::move(rgb));
+  nb::capsule owner(owned, [](void* p) noexcept { delete static_cast<std::vector<std::uint8_t>*>(p); });
+  const std::size_t shape[3] = {static_cast<std::size_t>(height), static_cast<std::size_t>(width), 3};
+  nb::dict d;
+  d["image"] = nb::ndarray<nb::numpy, std::uint8_t, nb::ndim<3>>(owned->data(), 3, shape, owner);
+  d["range"] = used;
+  d["quantity"] = quantity;
+  d["frame"] = file;
+  d["time"] = time;
+  return d;
+}
+
+}  // namespace
+
+void bind_render(nb::module_& m) {
+  m.def("render_frame", &render_frame, nb::arg("run_dir"), nb::arg("frame"), nb::arg("view"),
+        nb::arg("projection").none(), nb::arg("color").none(), nb::arg("width"), nb::arg("height"),
+        nb::arg("range").none(), nb::arg("png").none());
+}
+
+}  // namespace swirl::python
