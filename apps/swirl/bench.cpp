@@ -5,7 +5,7 @@
 //   swirl bench bh-table   [--sizes 1024,...,32768] [--schemes ...] [--iterations 50] [--opening 0.5]
 //   swirl bench bh-lambda  [--sizes 4096,32768] [--lambdas 0.3,0.5,0.7,0.9] [--schemes ...] [--iterations 20]
 //   swirl bench bh-phases  [--sizes ...] [--schemes subtree,subtree+paper] [--iterations 50] [--opening 0.5]
-//   swirl bench bh-opt     [--sizes 1024,...,32768] [--schemes subtree,subdomain] [--iterations N] [--rounds 3]
+//   swirl bench bh-opt     [--sizes 1024,...,32768] [--schemes subtree] [--iterations N] [--rounds 3]
 //                          [--opening 0.5] [--bin-dir DIR]
 // and on every suite: --out DIR (default bench/results/<suite>), --threads 1,2 (default 1 .. all), --quick.
 #include <fstream>
@@ -124,7 +124,7 @@ void add_bench_commands(CLI::App& app, Commands& commands) {
                 "Barnes-Hut built at -O0, -O1, -O2, -O3: the paper's Table 2 (needs cmake --build build --target swirl_bh_opt)",
                 common, [bo, common] { return bench::run_bh_opt(*bo, *common); });
   c->add_option("--sizes", bo->sizes, "Particle counts")->delimiter(',')->check(whole_number(1, kMaxCount));
-  c->add_option("--schemes", bo->schemes, "subtree,subdomain,global (on the paper's tree)")->delimiter(',');
+  c->add_option("--schemes", bo->schemes, "subtree,subdomain,global, on the paper's tree (default subtree)")->delimiter(',');
   c->add_option("--iterations", bo->iterations, "Iterations per run (default 50 * 1024 / N, 2 .. 50)")
       ->check(whole_number(1, kMaxCount));
   c->add_option("--rounds", bo->rounds, "Runs per level, the levels alternated (medians)")->check(whole_number(1, 1000));

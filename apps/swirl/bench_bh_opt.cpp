@@ -362,7 +362,9 @@ int run_bh_opt(BhOptArgs a, const CommonArgs& common) {
   rep.notes = fmt::format(
       "**What ran.** The experiment of `swirl bench bh-table` (gravity::time_iterations: a Plummer sphere, then per "
       "iteration a force evaluation on the paper's insertion-built octree and a leapfrog update; λ = {}, ε = 0.01, "
-      "double; the splits are swirl's defaults) from four programs, `swirl_bh_opt_O0` … `_O3` "
+      "double; the splits are swirl's defaults; by default the subtree scheme only, Table 2's by our inference, "
+      "and `--schemes subtree,subdomain` adds the other, which runs the same tree and walk code cut differently) "
+      "from four programs, `swirl_bh_opt_O0` … `_O3` "
       "(apps/bh_opt/CMakeLists.txt): each is the whole gravity module plus a small main compiled at one -O level, "
       "with the same other flags (-march=native in the release preset, assertions off, warnings as errors). Only "
       "Debian's prebuilt libstdc++, libgomp and libfmt are not rebuilt; the timed loop does not depend on them beyond "
