@@ -1,4 +1,4 @@
-"""`pip install .` from the repository root in a fresh venv, then import swirl and step a scene (slow: one test)."""
+"""`pip install .` from the repository root in a fresh venv, then import swirl, step a scene and run an example (slow: one test)."""
 
 import os
 import shutil
@@ -34,3 +34,8 @@ def test_pip_install_in_a_fresh_venv(tmp_path):
     )
     result = subprocess.run([python, "-c", script], check=True, capture_output=True, text=True, cwd=tmp_path)
     assert str(venv) in result.stdout
+    # And an example a newcomer runs first, small.
+    example = REPO / "examples" / "python" / "rotating_frame.py"
+    result = subprocess.run([python, str(example), "--count", "128", "--until", "0.5", "--out", str(tmp_path / "example")],
+                            check=True, capture_output=True, text=True, cwd=tmp_path)
+    assert "RMS distance" in result.stdout and (tmp_path / "example" / "difference.png").exists()
