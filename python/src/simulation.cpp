@@ -68,6 +68,13 @@ class PythonForce final : public Solver<Real> {
 };
 
 using Forces = std::vector<std::pair<std::string, nb::object>>;
+// Extra fields given with the particles: name, components (1 or 3), n·components doubles, particle by particle.
+struct ExtraField {
+  std::string name;
+  int components = 1;
+  std::vector<double> values;
+};
+using ExtraFields = std::vector<ExtraField>;
 
 // What Python sees of a Simulation<Real>, whichever Real.
 class AnySimulation {
@@ -100,10 +107,19 @@ class AnySimulation {
 template <class Real>
 class TypedSimulation final : public AnySimulation {
  public:
-  TypedSimulation(const scene::Scene& scene, const Forces& forces)
+  TypedSimulation(const scene::Scene& scene, const Forces& forces, const ExtraFields& fields)
       : sim_(sim::build_simulation<Real>(scene)), block_size_(scene.block_size), walls_(scene.walls),
         restitution_(scene.restitution) {
     for (const auto& [name, fn] : forces) sim_.add_solver(std::make_unique<PythonForce<Real>>(name, fn));
+    // Before start(): storage order is still the order given (a list source), and the
+    // first reorder carries the field along like every other.
+    auto& p = sim_.particles();
+    for (const auto& f : fields) {
+      const std::size_t k = p.add_field(f.name, f.components);
+      for (int c = 0; c < f.components; ++c)
+        for (std::size_t i = 0; i < p.size(); ++i)
+          p.extra(k, c)[i] = static_cast<Real>(f.values[i * static_cast<std::size_t>(f.components) + static_cast<std::size_t>(c)]);
+    }
   }
 
   // The initial forces; once, before anything else (the Python object exists by then, for the forces).
@@ -258,9 +274,10 @@ class TypedSimulation final : public AnySimulation {
   double initial_energy_ = 0;
 };
 
-std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene, const Forces& forces) {
-  if (scene.precision == scene::Precision::Float) return std::make_unique<TypedSimulation<float>>(scene, forces);
-  return std::make_unique<TypedSimulation<double>>(scene, forces);
+std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene, const Forces& forces,
+                                               const ExtraFields& fields = {}) {
+  if (scene.precision == scene::Precision::Float) return std::make_unique<TypedSimulation<float>>(scene, forces, fields);
+  return std::make_unique<TypedSimulation<double>>(scene, forces, fields);
 }
 
 // The Python-facing object: the simulation and the stepping loops.
@@ -355,11 +372,13 @@ void check_finite(const double* data, std::size_t n, std::size_t columns, const 
 
 using Rows = nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 using Column = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
+using AnyArray = nb::ndarray<const double, nb::c_contig, nb::device::cpu>;
 
 // The scene's physics with these particles instead of its [[particles]]:
 // one list source, validated as a scene file's list is.
 std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, std::optional<Rows> velocities,
-                                           Column masses, const Forces& forces) {
+                                           Column masses, const Forces& forces,
+                                           const std::vector<std::pair<std::string, AnyArray>>& named) {
   const std::size_t n = positions.shape(0);
   if (positions.shape(1) != 3) throw nb::value_error("positions must have shape (n, 3)");
   if (velocities && (velocities->shape(0) != n || velocities->shape(1) != 3))
@@ -370,6 +389,15 @@ std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, 
   check_finite(masses.data(), n, 1, "masses");
   for (std::size_t i = 0; i < n; ++i)
     if (!(masses.data()[i] > 0)) throw nb::value_error(fmt::format("masses[{}] is {}: a mass must be > 0", i, masses.data()[i]).c_str());
+  ExtraFields fields;
+  for (const auto& [name, a] : named) {
+    const bool vector = a.ndim() == 2 && a.shape(1) == 3;
+    if (!((a.ndim() == 1 || vector) && a.shape(0) == n))
+      throw nb::value_error(fmt::format("field '{}' must have shape ({},) or ({}, 3)", name, n, n).c_str());
+    const std::size_t components = vector ? 3 : 1;
+    check_finite(a.data(), n, components, name.c_str());
+    fields.push_back({name, static_cast<int>(components), std::vector<double>(a.data(), a.data() + n * components)});
+  }
   scene::Scene s = base.scene;
   scene::ListSource list;
   list.positions.resize(n);
@@ -387,7 +415,7 @@ std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, 
   s.file = (base.scene.file.empty() ? std::string("scene") : base.scene.file) + " (particles from arrays)";
   scene::validate(s);
   nb::gil_scoped_release release;
-  return make_simulation(s, forces);
+  return make_simulation(s, forces, fields);
 }
 
 }  // namespace
@@ -406,11 +434,12 @@ void bind_simulation(nb::module_& m) {
            nb::arg("scene"), nb::arg("forces"))
       .def_static(
           "from_arrays",
-          [](const PyScene& s, Rows positions, std::optional<Rows> velocities, Column masses, const Forces& forces) {
-            return new PySimulation(from_arrays(s, positions, velocities, masses, forces));
+          [](const PyScene& s, Rows positions, std::optional<Rows> velocities, Column masses, const Forces& forces,
+             const std::vector<std::pair<std::string, AnyArray>>& fields) {
+            return new PySimulation(from_arrays(s, positions, velocities, masses, forces, fields));
           },
           nb::arg("scene"), nb::arg("positions").noconvert(), nb::arg("velocities").noconvert().none(),
-          nb::arg("masses").noconvert(), nb::arg("forces"), nb::rv_policy::take_ownership)
+          nb::arg("masses").noconvert(), nb::arg("forces"), nb::arg("fields"), nb::rv_policy::take_ownership)
       .def("start",
            [](PySimulation& s) {
              nb::gil_scoped_release release;

@@ -113,7 +113,7 @@ class Simulation:
         self._native.start()
 
     @classmethod
-    def from_arrays(cls, scene, positions, velocities=None, masses=None, forces=None):
+    def from_arrays(cls, scene, positions, velocities=None, masses=None, forces=None, fields=None):
         """A simulation of the scene's physics with these particles instead of its ``[[particles]]``.
 
         ``positions``: (n, 3) array (m, or N-body length); ``velocities``:
@@ -126,6 +126,11 @@ class Simulation:
         The fields are stored in the scene's precision (``scene.precision``)
         whatever the arrays' dtype. Every other setting (dt, solvers, box,
         output) is the scene's. ``forces``: as for ``Simulation()``.
+        ``fields``: extra named fields, a dict name -> (n,) or (n, 3) array
+        (float32/float64, C-contiguous, finite; in the order of
+        ``positions``): they travel with the particles through every
+        reorder, are written to frames and checkpoints, and are read back
+        through ``sim.particles[name]``. A built-in name is refused.
         """
         if isinstance(scene, (str, os.PathLike)):
             scene = Scene.from_file(scene)
@@ -144,9 +149,16 @@ class Simulation:
                 raise ValueError(f"masses = {masses}: a mass must be finite and > 0")
         else:
             mass = _check_array("masses", masses, 1, n)
+        extra = []
+        for name, a in (fields or {}).items():
+            if not isinstance(name, str) or not name:
+                raise ValueError(f"field name {name!r}: give a non-empty string")
+            if not isinstance(a, np.ndarray) or a.ndim not in (1, 2):
+                raise ValueError(f"field {name!r}: give an (n,) or (n, 3) numpy array")
+            extra.append((name, _check_array(name, a, a.ndim, n)))
         self = cls.__new__(cls)
         self._scene = scene
-        self._native = _swirl.Simulation.from_arrays(scene._scene, pos, vel, mass, _forces(self, forces))
+        self._native = _swirl.Simulation.from_arrays(scene._scene, pos, vel, mass, _forces(self, forces), extra)
         self._native.start()
         return self
 

@@ -180,3 +180,23 @@ def test_from_arrays_fuzz(swirl, tiny_scene):
         built += 1
     assert built > 10 and refused > 100, (built, refused)
     print(f"from_arrays fuzz: {built} built, {refused} refused")
+
+
+def test_from_arrays_named_fields_travel_with_the_particles(swirl, nbody_scene):
+    # The Plummer stars, again, with a tag per star and a vector field: they follow each star through the re-sorts.
+    stars = swirl.Simulation(nbody_scene).particles.sorted_by_id()
+    n = len(stars["mass"])
+    tag = np.arange(n, dtype=np.float64) * 10.0
+    spin = np.ascontiguousarray(np.stack([tag, -tag, tag + 1], axis=1))
+    sim = swirl.Simulation.from_arrays(nbody_scene, stars["position"], stars["velocity"], stars["mass"],
+                                       fields={"tag": tag, "spin": spin})
+    sim.step(10)
+    assert "tag" in sim.particles.names and isinstance(sim.particles.spin, swirl.VectorField)
+    np.testing.assert_array_equal(sim.particles.sorted_by_id("tag"), tag)
+    np.testing.assert_array_equal(sim.particles.sorted_by_id("spin"), spin)
+    # The field of each particle, in storage order: the tag is 10 x its id.
+    np.testing.assert_array_equal(sim.particles.tag.copy(), sim.particles.id.copy() * 10.0)
+    with pytest.raises(ValueError, match="built-in"):
+        swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0, fields={"density": tag})
+    with pytest.raises(ValueError, match=r"has 3 rows"):
+        swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0, fields={"tag": tag[:3]})
