@@ -87,7 +87,8 @@ demo: deps-build
 
 # The seeds' experiments at their default sizes (each suite's CSV, JSON,
 # markdown and plots into bench/results/<suite>/), then docs/performance.md
-# regenerated from them. About 30 min on the 2-core machine.
+# regenerated from them. About 30 min on the 2-core machine, of which bh-opt
+# (the paper tree built at -O0..-O3, apps/bh_opt) about 2 min to build and 5 to run.
 BENCH_OUT ?= bench/results
 bench: build
 	./build/swirl bench sph-table --strategy hash,hash+serial,hash+serial+precomputed+after_distance,grid --out $(BENCH_OUT)/sph-table
@@ -95,6 +96,8 @@ bench: build
 	./build/swirl bench bh-table --out $(BENCH_OUT)/bh-table
 	./build/swirl bench bh-lambda --out $(BENCH_OUT)/bh-lambda
 	./build/swirl bench bh-phases --out $(BENCH_OUT)/bh-phases
+	cmake --build build -j $(JOBS) --target swirl_bh_opt
+	./build/swirl bench bh-opt --out $(BENCH_OUT)/bh-opt
 	/usr/bin/python3 tools/update_performance.py --results $(BENCH_OUT)
 
 asan-test: deps
