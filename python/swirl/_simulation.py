@@ -86,19 +86,23 @@ class Simulation:
     the stability condition) raises ``swirl.SimulationError`` naming the
     step, the particle and a fix, as the CLI reports it.
 
-    ``forces``: forces written in Python, added after the scene's: a dict
-    ``{name: f}`` or a list of functions (named by ``__name__``, a lambda
-    ``force<k>`` by its place). The engine
-    calls ``f(sim, t)`` at every force evaluation (once per step, and once
-    for the initial state), once the accelerations were zeroed and the scene's
-    own solvers have added theirs: ``f`` adds its
-    acceleration (m/s², or N-body units) into ``sim.particles.acceleration``
-    (``.x += ...``: vectorised over numpy views, which are fresh there) at
-    time ``t`` (the positions' time). Its cost is the phase
-    ``forces.python.<name>`` of ``sim.phases()`` (seconds). Energy is then
-    not known to be conserved (no relative energy error). An exception in
-    ``f`` propagates and leaves the simulation unusable (the state is inside
-    a step).
+    ``forces``: forces written in Python, added after the scene's own: a
+    dict ``{name: f}`` or a list of functions (named by ``__name__``; a
+    lambda by its place, ``force<k>``). The engine calls ``f(sim, t)`` at
+    every force evaluation (for the initial state, then once per step) once
+    the accelerations were zeroed and the scene's solvers added theirs; ``f``
+    adds its acceleration (m/s², or N-body units) at time ``t`` into
+    ``sim.particles.acceleration`` with numpy over the views, which are fresh
+    there. Its cost is the phase ``forces.python.<name>`` of ``sim.phases()``
+    (seconds). Energy is then not known to be conserved (no relative energy
+    error). An exception in ``f`` propagates and leaves the simulation
+    unusable (its state is inside a step).
+
+    Example::
+
+        sim = swirl.Simulation(swirl.Scene.from_file("examples/plummer.toml"))
+        sim.run(until=2.0, every=0.5, callback=lambda s: print(s.time, s.diagnostics()["total_energy"]))
+        r = np.hypot(sim.particles.position.x, sim.particles.position.y)   # views, no copy
     """
 
     __slots__ = ("_native", "_scene", "__weakref__")

@@ -88,18 +88,22 @@ class FieldArray(NDArrayOperatorsMixin):
 
     @property
     def shape(self):
+        """(n,): one value per particle."""
         return (self._count,)
 
     @property
     def dtype(self):
+        """numpy float32 or float64 (the scene's precision); int32 or uint64 for integer fields and ids."""
         return self._array.dtype
 
     @property
     def ndim(self):
+        """1."""
         return 1
 
     @property
     def size(self):
+        """n, the particle count when the view was made."""
         return self._count
 
     def __len__(self):

@@ -200,3 +200,27 @@ def test_from_arrays_named_fields_travel_with_the_particles(swirl, nbody_scene):
         swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0, fields={"density": tag})
     with pytest.raises(ValueError, match=r"has 3 rows"):
         swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0, fields={"tag": tag[:3]})
+
+
+def test_two_python_threads_step_two_simulations(swirl, sph_scene, nbody_scene):
+    # The GIL is released while stepping: two threads step at once, and each result is the sequential one.
+    import threading
+
+    def final(scene, steps):
+        sim = swirl.Simulation(scene)
+        sim.step(steps)
+        return sim.particles.sorted_by_id("position")
+
+    expected = [final(sph_scene, 30), final(nbody_scene, 30)]
+    results = [None, None]
+
+    def work(k, scene):
+        results[k] = final(scene, 30)
+
+    threads = [threading.Thread(target=work, args=(0, sph_scene)), threading.Thread(target=work, args=(1, nbody_scene))]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for got, want in zip(results, expected):
+        np.testing.assert_array_equal(got, want)
