@@ -3,12 +3,12 @@
 // between steps, its fields handed out as numpy arrays on the C++ memory.
 //
 // Views: field() returns a numpy array whose data is the field's own
-// AlignedVector storage and whose owner is the Python simulation object (the
-// memory lives as long as the array refers to it... until the particles are
-// reordered or resized: a reorder swaps every field with a scratch buffer, so
-// the old storage is freed). The Python side (python/swirl/_views.py) never
-// hands out such an array unchecked: it keeps the epoch and the count it was
-// made at and compares them (and the data pointer) before every use.
+// AlignedVector storage and whose owner is the Python simulation object, so
+// the simulation outlives the array. The storage itself does not: a reorder
+// swaps every field with a scratch buffer (the old one is freed) and a resize
+// reallocates. So the Python side (python/swirl/_views.py) wraps each array in
+// a FieldArray that keeps the epoch, the count and the data pointer it was
+// made at and compares them before every use (StaleViewError otherwise).
 #include <algorithm>
 #include <array>
 #include <cmath>
