@@ -345,12 +345,12 @@ void BarnesHut<Real>::split_paper_cells() {
   const std::size_t n = keys_.size();
   RunPacker pack(settings_.subdomain_size, runs_, ids_);
   for (std::size_t b = 0; b < n;) {
-    const auto [key_begin, key_end] = cell_keys(keys_[b].first, kPaperLevel);
+    const std::pair<std::uint64_t, std::uint64_t> cell = cell_keys(keys_[b].first, kPaperLevel);
     const auto e = std::size_t(std::partition_point(keys_.begin() + std::ptrdiff_t(b), keys_.end(),
-                                                    [&](const auto& k) { return k.first < key_end; }) -
+                                                    [&](const auto& k) { return k.first < cell.second; }) -
                                keys_.begin());
-    if (e - b <= settings_.subdomain_size) pack.add(b, e, key_begin, key_end);
-    else pack.cut(b, e, key_begin, key_end);
+    if (e - b <= settings_.subdomain_size) pack.add(b, e, cell.first, cell.second);
+    else pack.cut(b, e, cell.first, cell.second);
     b = e;
   }
   pack.close();
