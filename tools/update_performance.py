@@ -22,7 +22,7 @@ import tempfile
 # The seeds' suites first, in the order of the issue; any other suite found after them.
 SUITES = ["sph-table", "hash-stats", "bh-table", "bh-lambda", "bh-phases", "bh-opt"]
 COMMANDS = {
-    "sph-table": "build/swirl bench sph-table --strategy hash,grid --out bench/results/sph-table",
+    "sph-table": "build/swirl bench sph-table --strategy hash,hash+serial,hash+serial+precomputed+after_distance,grid --out bench/results/sph-table",
     "hash-stats": "build/swirl bench hash-stats --out bench/results/hash-stats",
     "bh-table": "build/swirl bench bh-table --out bench/results/bh-table",
     "bh-lambda": "build/swirl bench bh-lambda --out bench/results/bh-lambda",
