@@ -190,7 +190,12 @@ struct Reader {
     return out;
   }
 
-  SnapshotDataset dataset(hid_t group, const std::string& where, const std::string& name, std::size_t rows) const {
+  // A dataset opened and its shape checked: `rows` rows of 1 to 9 numbers.
+  struct OpenDataset {
+    Id set;
+    SnapshotLayout::Dataset shape;
+  };
+  OpenDataset open_dataset(hid_t group, const std::string& where, const std::string& name, std::size_t rows) const {
     const std::string at = where + "/" + name;
     Id set(H5Dopen2(group, name.c_str(), H5P_DEFAULT), H5Dclose);
     if (!set.valid()) fail(at, "is not a dataset");
@@ -205,12 +210,22 @@ struct Reader {
     Id type(H5Dget_type(set.get()), H5Tclose);
     const H5T_class_t cls = H5Tget_class(type.get());
     if (cls != H5T_INTEGER && cls != H5T_FLOAT) fail(at, "is not numeric");
+    const bool integer = cls == H5T_INTEGER;
+    return {std::move(set),
+            {name, int(dims[1]), integer, integer && H5Tget_sign(type.get()) == H5T_SGN_NONE,
+             int(H5Tget_size(type.get()))}};
+  }
+
+  // A dataset's values in double, every one finite.
+  SnapshotDataset dataset(hid_t group, const std::string& where, const std::string& name, std::size_t rows) const {
+    const std::string at = where + "/" + name;
+    const OpenDataset open = open_dataset(group, where, name, rows);
     SnapshotDataset d;
-    d.columns = std::size_t(dims[1]);
-    d.integer = cls == H5T_INTEGER;
-    d.units = text(set.get(), "units");
+    d.columns = std::size_t(open.shape.components);
+    d.integer = open.shape.integer;
+    d.units = text(open.set.get(), "units");
     d.values.resize(rows * d.columns);
-    if (rows > 0 && H5Dread(set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.values.data()) < 0)
+    if (rows > 0 && H5Dread(open.set.get(), H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.values.data()) < 0)
       fail(at, "cannot be read (corrupt or filtered with a filter this HDF5 lacks)");
     for (std::size_t k = 0; k < d.values.size(); ++k)
       if (!std::isfinite(d.values[k]))
@@ -389,12 +404,13 @@ SnapshotFile read_snapshot(const fs::path& path) {
   SnapshotFile out = std::move(o.head);
   const std::string& where = o.where;
   for (const auto& name : o.datasets) {
-    if (name == "ParticleIDs") {
-      const SnapshotDataset ids = r.dataset(o.group.get(), where, name, out.count);
-      if (ids.columns != 1 || !ids.integer) r.fail(where + "/ParticleIDs", "must be one integer per particle");
-      Id set(H5Dopen2(o.group.get(), "ParticleIDs", H5P_DEFAULT), H5Dclose);
+    if (name == "ParticleIDs") {  // read once, as the integers they are
+      const auto ids = r.open_dataset(o.group.get(), where, name, out.count);
+      if (ids.shape.components != 1 || !ids.shape.integer)
+        r.fail(where + "/ParticleIDs", "must be one integer per particle");
       out.ids.resize(out.count);
-      if (out.count > 0 && H5Dread(set.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.ids.data()) < 0)
+      if (out.count > 0 &&
+          H5Dread(ids.set.get(), H5T_NATIVE_UINT64, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.ids.data()) < 0)
         r.fail(where + "/ParticleIDs", "cannot be read as unsigned integers");
       continue;
     }
@@ -437,23 +453,8 @@ SnapshotLayout read_snapshot_layout(const fs::path& path) {
   layout.time = o.head.info.time;
   layout.type = o.head.info.type;
   layout.count = o.head.count;
-  for (const auto& name : o.datasets) {
-    const std::string at = o.where + "/" + name;
-    Id set(H5Dopen2(o.group.get(), name.c_str(), H5P_DEFAULT), H5Dclose);
-    Id space(set.valid() ? H5Dget_space(set.get()) : H5I_INVALID_HID, H5Sclose);
-    Id type(set.valid() ? H5Dget_type(set.get()) : H5I_INVALID_HID, H5Tclose);
-    if (!space.valid() || !type.valid()) o.r.fail(at, "cannot be opened");
-    const int rank = H5Sget_simple_extent_ndims(space.get());
-    hsize_t dims[2] = {0, 1};
-    if (rank < 1 || rank > 2) o.r.fail(at, fmt::format("has {} dimensions, expected 1 or 2", rank));
-    H5Sget_simple_extent_dims(space.get(), dims, nullptr);
-    if (dims[0] != layout.count) o.r.fail(at, fmt::format("has {} rows, the header says {} particles", dims[0], layout.count));
-    const H5T_class_t cls = H5Tget_class(type.get());
-    if (cls != H5T_INTEGER && cls != H5T_FLOAT) o.r.fail(at, "is not numeric");
-    layout.datasets.push_back({name, rank == 1 ? 1 : int(dims[1]), cls == H5T_INTEGER,
-                               cls == H5T_INTEGER && H5Tget_sign(type.get()) == H5T_SGN_NONE,
-                               int(H5Tget_size(type.get()))});
-  }
+  for (const auto& name : o.datasets)
+    layout.datasets.push_back(o.r.open_dataset(o.group.get(), o.where, name, layout.count).shape);
   return layout;
 }
 
