@@ -13,27 +13,16 @@
 
 namespace {
 
-std::vector<std::string> split_quoted(const std::string& line) {
-  std::vector<std::string> cells(1);
-  bool quoted = false;
-  for (char c : line) {
-    if (c == '"') quoted = !quoted;
-    else if (c == ',' && !quoted) cells.emplace_back();
-    else cells.back() += c;
-  }
-  return cells;
-}
-
 // The CSV as one map per row, keyed by column.
 std::vector<std::map<std::string, std::string>> read_rows(const fs::path& p) {
   std::istringstream in(slurp(p));
   std::string line;
   std::vector<std::map<std::string, std::string>> rows;
   if (!std::getline(in, line)) return rows;
-  const auto header = split_quoted(line);
+  const auto header = csv_cells(line);
   while (std::getline(in, line)) {
     if (line.empty()) continue;
-    const auto cells = split_quoted(line);
+    const auto cells = csv_cells(line);
     EXPECT_EQ(cells.size(), header.size()) << line;
     std::map<std::string, std::string> row;
     for (std::size_t i = 0; i < header.size() && i < cells.size(); ++i) row[header[i]] = cells[i];

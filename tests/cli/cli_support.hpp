@@ -27,17 +27,24 @@ inline std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// A CSV file's rows (the header first), split at commas.
+// One CSV line's cells, split at commas outside double quotes (the quotes dropped).
+inline std::vector<std::string> csv_cells(const std::string& line) {
+  std::vector<std::string> cells(1);
+  bool quoted = false;
+  for (char c : line) {
+    if (c == '"') quoted = !quoted;
+    else if (c == ',' && !quoted) cells.emplace_back();
+    else cells.back() += c;
+  }
+  return cells;
+}
+
+// A CSV file's rows (the header first).
 inline std::vector<std::vector<std::string>> csv_rows(const fs::path& file) {
   std::vector<std::vector<std::string>> rows;
   std::istringstream in(slurp(file));
   std::string line;
-  while (std::getline(in, line)) {
-    rows.emplace_back();
-    std::istringstream fields(line);
-    std::string field;
-    while (std::getline(fields, field, ',')) rows.back().push_back(field);
-  }
+  while (std::getline(in, line)) rows.push_back(csv_cells(line));
   return rows;
 }
 
