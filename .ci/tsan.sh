@@ -227,15 +227,29 @@ if grep -q "ThreadSanitizer" "$canary_dir/clean.log"; then
   cat "$canary_dir/clean.log"; echo "tsan: a report on race-free code (false positive)" >&2; exit 1
 fi
 echo "tsan: Archer loaded ($OMP_TOOL_LIBRARIES); race-free code: no report"
+# TSan itself misses a real race now and then: on a loaded 2-core machine the
+# for-blocks race went unreported in about 1 run in 50 although updates were
+# lost (measured 2026-12-02 during a build: 5 of 250 runs, also with one racing write per
+# block and with history_size=7). So each race gets up to 4 runs: a setup that
+# cannot see races fails all 4, a working one misses all 4 about once in 10^6.
+attempts=4
 for mode in parallel-for for-blocks single-nowait; do
-  status=0
-  "${run[@]}" "$canary_dir/canary" "$mode" >"$canary_dir/$mode.log" 2>&1 || status=$?
-  if [ "$status" -ne 66 ] || ! grep -q "WARNING: ThreadSanitizer: data race" "$canary_dir/$mode.log"; then
+  reported=""
+  for attempt in $(seq 1 $attempts); do
+    status=0
+    "${run[@]}" "$canary_dir/canary" "$mode" >"$canary_dir/$mode.log" 2>&1 || status=$?
+    if [ "$status" -eq 66 ] && grep -q "WARNING: ThreadSanitizer: data race" "$canary_dir/$mode.log"; then
+      reported="$attempt"
+      break
+    fi
+    echo "tsan: deliberate race '$mode' not reported in run $attempt of $attempts (exit $status): $(tr '\n' ' ' <"$canary_dir/$mode.log" | cut -c1-200)"
+  done
+  if [ -z "$reported" ]; then
     cat "$canary_dir/$mode.log"
-    echo "tsan: the deliberate race '$mode' was NOT reported (exit $status): this setup cannot be trusted" >&2
+    echo "tsan: the deliberate race '$mode' was NOT reported in $attempts runs: this setup cannot be trusted" >&2
     exit 1
   fi
-  echo "tsan: deliberate race '$mode' reported: $(grep -m1 -o 'canary.cpp:[0-9]*' "$canary_dir/$mode.log")"
+  echo "tsan: deliberate race '$mode' reported (run $reported): $(grep -m1 -o 'canary.cpp:[0-9]*' "$canary_dir/$mode.log")"
 done
 
 echo "== tsan: tests"
