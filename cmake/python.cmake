@@ -20,7 +20,7 @@ find_package(nanobind CONFIG REQUIRED PATHS "${SWIRL_NANOBIND_DIR}" NO_DEFAULT_P
 # this build tree only (the CLI's trees are unchanged). -fno-semantic-interposition
 # keeps GCC inlining and calling swirl's own functions directly as it does
 # without -fPIC (nothing interposes them: the module hides every symbol).
-foreach(lib swirl_io swirl_gravity swirl_scene swirl_sph swirl_sim swirl_render)
+foreach(lib swirl_io swirl_gravity swirl_scene swirl_sph swirl_sim swirl_render swirl_cli_commands)
   set_target_properties(${lib} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   target_compile_options(${lib} PRIVATE -fno-semantic-interposition)
 endforeach()
@@ -30,8 +30,9 @@ nanobind_add_module(_swirl NB_STATIC
   ${PROJECT_SOURCE_DIR}/python/src/scene.cpp
   ${PROJECT_SOURCE_DIR}/python/src/simulation.cpp
   ${PROJECT_SOURCE_DIR}/python/src/run.cpp
-  ${PROJECT_SOURCE_DIR}/python/src/render.cpp)
-target_link_libraries(_swirl PRIVATE swirl::swirl)
+  ${PROJECT_SOURCE_DIR}/python/src/render.cpp
+  ${PROJECT_SOURCE_DIR}/python/src/cli.cpp)
+target_link_libraries(_swirl PRIVATE swirl::swirl swirl_cli_commands)
 # swirl's warnings (errors) on the binding sources; nanobind's and Python's
 # headers as system headers (GCC drops a -I for a directory also given with -isystem).
 swirl_target_options(_swirl)

@@ -131,6 +131,9 @@ int run(const RunArgs& args) {
     render::Font{};
     options.on_frame = render::render_every(options.out_dir, args.render_every);
   }
+  // Cleared first: run_cli() may run many times in one process (the Python module).
+  g_stop.store(false);
+  g_signal.store(0);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 

@@ -7,6 +7,7 @@
 //   run.cpp         sim::run_scene (frames, diagnostics, checkpoints, resume) as
 //                   `swirl run` calls it, and the summary as a dict
 //   render.cpp      a run folder's frame drawn as `swirl render` draws it
+//   cli.cpp         the whole command-line tool in-process (swirl.cli, swirl.bench)
 #pragma once
 
 #include <nanobind/nanobind.h>
@@ -26,6 +27,7 @@ void bind_scene(nb::module_& m);
 void bind_simulation(nb::module_& m);
 void bind_run(nb::module_& m);
 void bind_render(nb::module_& m);
+void bind_cli(nb::module_& m);
 
 // Raises KeyboardInterrupt (or whatever a signal handler raised) if a signal
 // arrived. Call with the GIL held, between steps.

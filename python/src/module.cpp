@@ -29,6 +29,7 @@ NB_MODULE(_swirl, m) {
   bind_simulation(m);
   bind_run(m);
   bind_render(m);
+  bind_cli(m);
 }
 
 }  // namespace swirl::python

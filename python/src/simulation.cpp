@@ -75,6 +75,12 @@ struct ExtraField {
   std::vector<double> values;
 };
 using ExtraFields = std::vector<ExtraField>;
+// Extra integer fields (1 component of std::int32_t), particle by particle.
+struct ExtraIntField {
+  std::string name;
+  std::vector<std::int32_t> values;
+};
+using ExtraIntFields = std::vector<ExtraIntField>;
 
 // What Python sees of a Simulation<Real>, whichever Real.
 class AnySimulation {
@@ -107,7 +113,8 @@ class AnySimulation {
 template <class Real>
 class TypedSimulation final : public AnySimulation {
  public:
-  TypedSimulation(const scene::Scene& scene, const Forces& forces, const ExtraFields& fields)
+  TypedSimulation(const scene::Scene& scene, const Forces& forces, const ExtraFields& fields,
+                  const ExtraIntFields& int_fields)
       : sim_(sim::build_simulation<Real>(scene)), block_size_(scene.block_size), walls_(scene.walls),
         restitution_(scene.restitution) {
     for (const auto& [name, fn] : forces) sim_.add_solver(std::make_unique<PythonForce<Real>>(name, fn));
@@ -119,6 +126,10 @@ class TypedSimulation final : public AnySimulation {
       for (int c = 0; c < f.components; ++c)
         for (std::size_t i = 0; i < p.size(); ++i)
           p.extra(k, c)[i] = static_cast<Real>(f.values[i * static_cast<std::size_t>(f.components) + static_cast<std::size_t>(c)]);
+    }
+    for (const auto& f : int_fields) {
+      const std::size_t k = p.add_int_field(f.name);
+      std::copy(f.values.begin(), f.values.end(), p.int_field(k).begin());
     }
   }
 
@@ -275,9 +286,10 @@ class TypedSimulation final : public AnySimulation {
 };
 
 std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene, const Forces& forces,
-                                               const ExtraFields& fields = {}) {
-  if (scene.precision == scene::Precision::Float) return std::make_unique<TypedSimulation<float>>(scene, forces, fields);
-  return std::make_unique<TypedSimulation<double>>(scene, forces, fields);
+                                               const ExtraFields& fields = {}, const ExtraIntFields& int_fields = {}) {
+  if (scene.precision == scene::Precision::Float)
+    return std::make_unique<TypedSimulation<float>>(scene, forces, fields, int_fields);
+  return std::make_unique<TypedSimulation<double>>(scene, forces, fields, int_fields);
 }
 
 // The Python-facing object: the simulation and the stepping loops.
@@ -373,12 +385,14 @@ void check_finite(const double* data, std::size_t n, std::size_t columns, const 
 using Rows = nb::ndarray<const double, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 using Column = nb::ndarray<const double, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 using AnyArray = nb::ndarray<const double, nb::c_contig, nb::device::cpu>;
+using IntColumn = nb::ndarray<const std::int32_t, nb::ndim<1>, nb::c_contig, nb::device::cpu>;
 
 // The scene's physics with these particles instead of its [[particles]]:
 // one list source, validated as a scene file's list is.
 std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, std::optional<Rows> velocities,
                                            Column masses, const Forces& forces,
-                                           const std::vector<std::pair<std::string, AnyArray>>& named) {
+                                           const std::vector<std::pair<std::string, AnyArray>>& named,
+                                           const std::vector<std::pair<std::string, IntColumn>>& named_int) {
   const std::size_t n = positions.shape(0);
   if (positions.shape(1) != 3) throw nb::value_error("positions must have shape (n, 3)");
   if (velocities && (velocities->shape(0) != n || velocities->shape(1) != 3))
@@ -398,6 +412,11 @@ std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, 
     check_finite(a.data(), n, components, name.c_str());
     fields.push_back({name, static_cast<int>(components), std::vector<double>(a.data(), a.data() + n * components)});
   }
+  ExtraIntFields int_fields;
+  for (const auto& [name, a] : named_int) {
+    if (a.shape(0) != n) throw nb::value_error(fmt::format("field '{}' must have shape ({},)", name, n).c_str());
+    int_fields.push_back({name, std::vector<std::int32_t>(a.data(), a.data() + n)});
+  }
   scene::Scene s = base.scene;
   scene::ListSource list;
   list.positions.resize(n);
@@ -415,7 +434,7 @@ std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, 
   s.file = (base.scene.file.empty() ? std::string("scene") : base.scene.file) + " (particles from arrays)";
   scene::validate(s);
   nb::gil_scoped_release release;
-  return make_simulation(s, forces, fields);
+  return make_simulation(s, forces, fields, int_fields);
 }
 
 }  // namespace
@@ -435,11 +454,13 @@ void bind_simulation(nb::module_& m) {
       .def_static(
           "from_arrays",
           [](const PyScene& s, Rows positions, std::optional<Rows> velocities, Column masses, const Forces& forces,
-             const std::vector<std::pair<std::string, AnyArray>>& fields) {
-            return new PySimulation(from_arrays(s, positions, velocities, masses, forces, fields));
+             const std::vector<std::pair<std::string, AnyArray>>& fields,
+             const std::vector<std::pair<std::string, IntColumn>>& int_fields) {
+            return new PySimulation(from_arrays(s, positions, velocities, masses, forces, fields, int_fields));
           },
           nb::arg("scene"), nb::arg("positions").noconvert(), nb::arg("velocities").noconvert().none(),
-          nb::arg("masses").noconvert(), nb::arg("forces"), nb::arg("fields"), nb::rv_policy::take_ownership)
+          nb::arg("masses").noconvert(), nb::arg("forces"), nb::arg("fields"), nb::arg("int_fields"),
+          nb::rv_policy::take_ownership)
       .def("start",
            [](PySimulation& s) {
              nb::gil_scoped_release release;

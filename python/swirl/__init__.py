@@ -17,6 +17,8 @@ Names:
     run, resume      runs into a run folder as ``swirl run`` (frames, diagnostics, checkpoints)
     read_diagnostics a run folder's diagnostics.csv as numpy arrays
     render           a run folder's frame as an RGB numpy image (and a PNG), as ``swirl render``
+    bench            a ``swirl bench`` suite, its results as a dict (BenchResult)
+    cli              the whole command-line tool in this process: ``swirl.cli(["run", ...])``
     set_threads, threads
     SceneError (ValueError), SimulationError (RuntimeError), IoError (OSError), StaleViewError (RuntimeError)
 
@@ -24,6 +26,7 @@ docs/python.md in the repository is the full page.
 """
 
 from . import _swirl
+from ._cli import BenchResult, bench, cli
 from ._run import read_diagnostics, render, resume, run
 from ._scene import Scene
 from ._simulation import Simulation
@@ -54,4 +57,5 @@ def threads():
 
 
 __all__ = ["Scene", "Simulation", "Particles", "VectorField", "FieldArray", "run", "resume", "read_diagnostics", "render",
+           "bench", "BenchResult", "cli",
            "set_threads", "threads", "SceneError", "SimulationError", "IoError", "StaleViewError", "__version__"]

@@ -31,6 +31,22 @@ def _check_array(name, a, ndim, n=None):
     return np.asarray(a, dtype=np.float64)
 
 
+def _check_int_array(name, a, n):
+    """An integer field of from_arrays: a C-contiguous (n,) array of any integer dtype, every value in int32."""
+    if a.ndim != 1:
+        raise ValueError(f"{name} has shape {a.shape}: an integer field must be (n,)")
+    if a.shape[0] != n:
+        raise ValueError(f"{name} has {a.shape[0]} rows but positions has {n}: one per particle")
+    if not a.flags.c_contiguous:
+        raise ValueError(f"{name} is not C-contiguous (a slice or a transpose?): pass np.ascontiguousarray({name})")
+    info = np.iinfo(np.int32)
+    if a.size and (a.min() < info.min or a.max() > info.max):
+        bad = int(np.argmax((a < info.min) | (a > info.max)))
+        raise ValueError(f"{name}[{bad}] is {a[bad]}: integer fields are stored as int32 "
+                         f"({info.min} .. {info.max})")
+    return np.ascontiguousarray(a, dtype=np.int32)
+
+
 def _forces(sim, forces):
     """(name, fn(t)) pairs for the engine from the user's forces: dict name -> f, or a list of callables."""
     if forces is None:
@@ -132,9 +148,11 @@ class Simulation:
         output) is the scene's. ``forces``: as for ``Simulation()``.
         ``fields``: extra named fields, a dict name -> (n,) or (n, 3) array
         (float32/float64, C-contiguous, finite; in the order of
-        ``positions``): they travel with the particles through every
-        reorder, are written to frames and checkpoints, and are read back
-        through ``sim.particles[name]``. A built-in name is refused.
+        ``positions``), or an (n,) array of any integer dtype with values
+        that fit int32 (stored as int32: a material, a label): they travel
+        with the particles through every reorder, are written to frames and
+        checkpoints, and are read back through ``sim.particles[name]``. A
+        built-in name is refused.
         """
         if isinstance(scene, (str, os.PathLike)):
             scene = Scene.from_file(scene)
@@ -153,16 +171,20 @@ class Simulation:
                 raise ValueError(f"masses = {masses}: a mass must be finite and > 0")
         else:
             mass = _check_array("masses", masses, 1, n)
-        extra = []
+        extra, extra_int = [], []
         for name, a in (fields or {}).items():
             if not isinstance(name, str) or not name:
                 raise ValueError(f"field name {name!r}: give a non-empty string")
             if not isinstance(a, np.ndarray) or a.ndim not in (1, 2):
                 raise ValueError(f"field {name!r}: give an (n,) or (n, 3) numpy array")
-            extra.append((name, _check_array(name, a, a.ndim, n)))
+            if a.dtype.kind in "iu":
+                extra_int.append((name, _check_int_array(name, a, n)))
+            else:
+                extra.append((name, _check_array(name, a, a.ndim, n)))
         self = cls.__new__(cls)
         self._scene = scene
-        self._native = _swirl.Simulation.from_arrays(scene._scene, pos, vel, mass, _forces(self, forces), extra)
+        self._native = _swirl.Simulation.from_arrays(scene._scene, pos, vel, mass, _forces(self, forces), extra,
+                                                     extra_int)
         self._native.start()
         return self
 

@@ -39,3 +39,6 @@ def test_pip_install_in_a_fresh_venv(tmp_path):
     result = subprocess.run([python, str(example), "--count", "128", "--until", "0.5", "--out", str(tmp_path / "example")],
                             check=True, capture_output=True, text=True, cwd=tmp_path)
     assert "RMS distance" in result.stdout and (tmp_path / "example" / "difference.png").exists()
+    # The `swirl` command the package installs: the same tool as the executable.
+    result = subprocess.run([str(venv / "bin" / "swirl"), "--version"], check=True, capture_output=True, text=True)
+    assert result.stdout.startswith("swirl ")

@@ -202,6 +202,30 @@ def test_from_arrays_named_fields_travel_with_the_particles(swirl, nbody_scene):
         swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0, fields={"tag": tag[:3]})
 
 
+def test_from_arrays_integer_fields(swirl, nbody_scene, tmp_path):
+    # An integer label per star (any integer dtype in, int32 stored): it follows each star and goes into frames.
+    stars = swirl.Simulation(nbody_scene).particles.sorted_by_id()
+    n = len(stars["mass"])
+    label = (np.arange(n, dtype=np.int64) % 7) - 3
+    sim = swirl.Simulation.from_arrays(nbody_scene, stars["position"], stars["velocity"], stars["mass"],
+                                       fields={"label": label, "tag": label.astype(np.float64)})
+    sim.step(10)
+    assert sim.particles.label.dtype == np.int32
+    np.testing.assert_array_equal(sim.particles.sorted_by_id("label"), label)
+    np.testing.assert_array_equal(sim.particles.label.copy(), sim.particles.tag.copy().astype(np.int32))
+    sim.write_frame(tmp_path / "f.vtp")
+    assert b'Name="label"' in (tmp_path / "f.vtp").read_bytes()
+    with pytest.raises(ValueError, match=r"label\[2\] is 4294967296: integer fields are stored as int32"):
+        swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0,
+                                     fields={"label": np.array([0, 1, 2**32] + [0] * (n - 3))})
+    with pytest.raises(ValueError, match=r"integer field must be \(n,\)"):
+        swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0,
+                                     fields={"label": np.zeros((n, 3), dtype=np.int32)})
+    with pytest.raises(ValueError, match="built-in"):
+        swirl.Simulation.from_arrays(nbody_scene, stars["position"], masses=1.0,
+                                     fields={"mass": np.zeros(n, dtype=np.int32)})
+
+
 def test_two_python_threads_step_two_simulations(swirl, sph_scene, nbody_scene):
     # The GIL is released while stepping: two threads step at once, and each result is the sequential one.
     import threading
