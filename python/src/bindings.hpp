@@ -10,13 +10,33 @@
 //   cli.cpp         the whole command-line tool in-process (swirl.cli, swirl.bench)
 #pragma once
 
+#include <string>
+#include <utility>
+#include <vector>
+
 #include <nanobind/nanobind.h>
 
 #include "swirl/scene/scene.hpp"
 
+namespace swirl {
+template <class Real>
+class Simulation;
+}  // namespace swirl
+
 namespace swirl::python {
 
 namespace nb = nanobind;
+
+// Forces written in Python: (phase name, fn(t)) pairs (python/swirl/_simulation.py's _forces()).
+using Forces = std::vector<std::pair<std::string, nb::object>>;
+
+// simulation.cpp: a run's simulation (swirl.run with forces or a callback) as
+// a _swirl.Simulation object that does not own it, with the Python forces
+// added as solvers; detach_simulation() cuts the object off when the run ends
+// (every later use raises). Call both with the GIL held.
+template <class Real>
+nb::object borrow_simulation(Simulation<Real>& sim, const scene::Scene& scene, const Forces& forces);
+void detach_simulation(nb::handle native);
 
 // A validated scene, as the loader returns it.
 struct PyScene {

@@ -4,17 +4,27 @@
 // moment: a pending signal (Ctrl-C) or an exception from the Python progress
 // callback asks the run to stop after the current step, as SIGINT does in the
 // CLI (a checkpoint is written), and is raised once run_scene returned.
+//
+// Forces and a callback written in Python enter the run through its
+// RunExtension (sim/run.hpp): the forces as solvers of the run's simulation,
+// the callback as an observer that calls callback(sim) every N steps or every
+// T of simulated time, where `sim` is a _swirl.Simulation on the run's own
+// simulation (borrow_simulation), cut off when the run ends.
 #include <atomic>
 #include <filesystem>
 #include <optional>
 #include <string>
 
 #include <nanobind/stl/optional.h>
+#include <nanobind/stl/pair.h>
 #include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
 #include "swirl/scene/load.hpp"
+#include "swirl/sim/observer.hpp"
 #include "swirl/sim/run.hpp"
+#include "swirl/sim/simulation.hpp"
 
 namespace swirl::python {
 namespace {
@@ -58,6 +68,78 @@ nb::dict summary_dict(const sim::RunSummary& s) {
   return d;
 }
 
+// What Python adds to a run, and what it left to raise. Touched with the GIL held only.
+struct PythonHooks {
+  Forces forces;
+  nb::object callback;                       // callback(): the Python side calls the user's f(sim)
+  std::optional<std::uint64_t> every_steps;  // call it every N steps ...
+  std::optional<double> every_time;          // ... or at every multiple of T of simulated time
+  nb::object attach;                         // attach(native): hands the borrowed simulation to Python
+  nb::object native;                         // that simulation, detached when the run ends
+  std::atomic<bool>* stop = nullptr;
+  std::optional<nb::python_error> raised;
+
+  bool any() const { return !forces.empty() || !callback.is_none(); }
+  // Calls fn(args...) unless something was raised already; an exception is
+  // kept (raised once the run returned) and stops the run after this step.
+  template <class... Args>
+  nb::object guarded(const nb::object& fn, Args&&... args) {
+    if (raised) return nb::none();
+    try {
+      return fn(std::forward<Args>(args)...);
+    } catch (nb::python_error& e) {
+      raised.emplace(std::move(e));
+      *stop = true;
+      return nb::none();
+    }
+  }
+};
+
+// The Python callback as an observer of the run: due every N steps (stateless)
+// or at the times of an interval (IntervalSchedule, saved in checkpoints so a
+// resumed run calls it where the uninterrupted one would have; adaptive steps
+// land on those times).
+template <class Real>
+class PythonCallback final : public sim::Observer<Real> {
+ public:
+  PythonCallback(PythonHooks& hooks, double dt)
+      : hooks_(hooks), schedule_(hooks.every_time.value_or(0), dt) {}
+  std::string_view name() const override { return "python_callback"; }
+  void on_step(Simulation<Real>& sim) override {
+    const bool due = hooks_.every_steps ? sim.step_count() % *hooks_.every_steps == 0 : schedule_.due(sim.time());
+    if (!due) return;
+    if (!hooks_.every_steps) schedule_.acted(sim.time());
+    nb::gil_scoped_acquire gil;
+    nb::object r = hooks_.guarded(hooks_.callback);
+    if (r.is(nb::bool_(false))) *hooks_.stop = true;
+  }
+  std::optional<double> next_time(const Simulation<Real>&) const override {
+    return hooks_.every_steps ? std::nullopt : schedule_.next_time();
+  }
+  void save_state(NamedValues& out) const override {
+    out.emplace_back("python_callback.next", static_cast<double>(schedule_.next_index()));
+  }
+  void load_state(const NamedValues& values) override {
+    if (const auto k = find_value(values, "python_callback.next")) schedule_.set_next_index(static_cast<std::uint64_t>(*k));
+  }
+
+ private:
+  PythonHooks& hooks_;
+  sim::IntervalSchedule schedule_;
+};
+
+template <class Real>
+sim::RunExtension<Real> python_extension(const scene::Scene& scene, PythonHooks& hooks) {
+  return [&scene, &hooks](Simulation<Real>& sim) {
+    nb::gil_scoped_acquire gil;
+    hooks.native = borrow_simulation<Real>(sim, scene, hooks.forces);
+    hooks.attach(hooks.native);
+    std::vector<std::shared_ptr<sim::Observer<Real>>> observers;
+    if (!hooks.callback.is_none()) observers.push_back(std::make_shared<PythonCallback<Real>>(hooks, scene.dt));
+    return observers;
+  };
+}
+
 struct RunArgs {
   std::optional<std::uint64_t> steps;
   std::optional<double> until;
@@ -69,7 +151,8 @@ struct RunArgs {
   std::string on_blowup = "stop";
 };
 
-nb::dict run(const scene::Scene& scene, const std::string& out_dir, bool resume, const RunArgs& a, nb::object progress) {
+nb::dict run(const scene::Scene& scene, const std::string& out_dir, bool resume, const RunArgs& a, nb::object progress,
+             PythonHooks& hooks) {
   sim::RunOptions options;
   options.out_dir = out_dir;
   options.resume = resume;
@@ -86,33 +169,35 @@ nb::dict run(const scene::Scene& scene, const std::string& out_dir, bool resume,
   else throw nb::value_error(("on_blowup '" + a.on_blowup + "': give \"stop\", \"warn\" or \"off\"").c_str());
   std::atomic<bool> stop{false};
   options.stop = &stop;
-  std::optional<nb::python_error> raised;  // touched with the GIL held only
+  hooks.stop = &stop;
+  if (hooks.any()) {
+    options.extend_float = python_extension<float>(scene, hooks);
+    options.extend_double = python_extension<double>(scene, hooks);
+  }
+  const nb::object signals = nb::cpp_function([] { check_signals(); });
   auto on_progress = [&](const sim::RunProgress& p) {
     nb::gil_scoped_acquire gil;
-    if (raised) return;
-    try {
-      check_signals();
-      if (!progress.is_none()) {
-        nb::dict d;
-        d["step"] = p.step;
-        d["first_step"] = p.first_step;
-        d["total_steps"] = p.total_steps;
-        d["time"] = p.sim_time;
-        d["wall_seconds"] = p.wall_seconds;
-        nb::object r = progress(d);
-        if (r.is(nb::bool_(false))) stop = true;
-      }
-    } catch (nb::python_error& e) {
-      raised.emplace(std::move(e));
-      stop = true;
+    hooks.guarded(signals);
+    if (!progress.is_none() && !hooks.raised) {
+      nb::dict d;
+      d["step"] = p.step;
+      d["first_step"] = p.first_step;
+      d["total_steps"] = p.total_steps;
+      d["time"] = p.sim_time;
+      d["wall_seconds"] = p.wall_seconds;
+      if (hooks.guarded(progress, d).is(nb::bool_(false))) stop = true;
     }
   };
   sim::RunSummary summary;
-  {
+  try {
     nb::gil_scoped_release release;
     summary = sim::run_scene(scene, options, on_progress);
+  } catch (...) {
+    if (hooks.native.is_valid()) detach_simulation(hooks.native);
+    throw;
   }
-  if (raised) throw std::move(*raised);
+  if (hooks.native.is_valid()) detach_simulation(hooks.native);
+  if (hooks.raised) throw std::move(*hooks.raised);
   return summary_dict(summary);
 }
 
@@ -124,16 +209,19 @@ void bind_run(nb::module_& m) {
       [](const PyScene& s, const std::string& out_dir, bool resume, std::optional<std::uint64_t> steps,
          std::optional<double> until, int threads, bool overwrite, std::optional<double> checkpoint_every,
          std::optional<std::uint64_t> checkpoint_every_steps, std::size_t checkpoint_keep, const std::string& on_blowup,
-         nb::object progress) {
+         nb::object progress, const Forces& forces, nb::object callback, std::optional<std::uint64_t> every_steps,
+         std::optional<double> every_time, nb::object attach) {
+        PythonHooks hooks{forces, std::move(callback), every_steps, every_time, std::move(attach), {}, nullptr, {}};
         return run(s.scene, out_dir, resume,
                    RunArgs{steps, until, threads, overwrite, checkpoint_every, checkpoint_every_steps, checkpoint_keep,
                            on_blowup},
-                   progress);
+                   progress, hooks);
       },
       nb::arg("scene"), nb::arg("out_dir"), nb::arg("resume"), nb::arg("steps").none(), nb::arg("until").none(),
       nb::arg("threads"), nb::arg("overwrite"), nb::arg("checkpoint_every").none(),
       nb::arg("checkpoint_every_steps").none(), nb::arg("checkpoint_keep"), nb::arg("on_blowup"),
-      nb::arg("progress").none());
+      nb::arg("progress").none(), nb::arg("forces"), nb::arg("callback").none(), nb::arg("every_steps").none(),
+      nb::arg("every_time").none(), nb::arg("attach").none());
 }
 
 }  // namespace swirl::python

@@ -18,6 +18,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -67,7 +68,6 @@ class PythonForce final : public Solver<Real> {
   nb::object fn_;
 };
 
-using Forces = std::vector<std::pair<std::string, nb::object>>;
 // Extra fields given with the particles: name, components (1 or 3), n·components doubles, particle by particle.
 struct ExtraField {
   std::string name;
@@ -87,6 +87,9 @@ class AnySimulation {
  public:
   virtual ~AnySimulation() = default;
   virtual void start() = 0;
+  // A run's simulation (not owned, not stepped from Python), and cutting it off when the run ends.
+  virtual bool borrowed() const = 0;
+  virtual void detach() = 0;
   virtual void step(std::optional<double> land_at) = 0;
   virtual double time() const = 0;
   virtual std::uint64_t steps() const = 0;
@@ -115,12 +118,12 @@ class TypedSimulation final : public AnySimulation {
  public:
   TypedSimulation(const scene::Scene& scene, const Forces& forces, const ExtraFields& fields,
                   const ExtraIntFields& int_fields)
-      : sim_(sim::build_simulation<Real>(scene)), block_size_(scene.block_size), walls_(scene.walls),
-        restitution_(scene.restitution) {
-    for (const auto& [name, fn] : forces) sim_.add_solver(std::make_unique<PythonForce<Real>>(name, fn));
+      : owned_(std::in_place, BuiltBy{[&] { return sim::build_simulation<Real>(scene); }}), sim_(&*owned_),
+        block_size_(scene.block_size), walls_(scene.walls), restitution_(scene.restitution) {
+    add_python_forces(live(), forces);
     // Before start(): storage order is still the order given (a list source), and the
     // first reorder carries the field along like every other.
-    auto& p = sim_.particles();
+    auto& p = live().particles();
     for (const auto& f : fields) {
       const std::size_t k = p.add_field(f.name, f.components);
       for (int c = 0; c < f.components; ++c)
@@ -133,24 +136,38 @@ class TypedSimulation final : public AnySimulation {
     }
   }
 
+  // A run's simulation (swirl.run's callback), not owned: it is the run's, and
+  // detach() cuts this object off from it when the run ends.
+  TypedSimulation(Simulation<Real>& borrowed, const scene::Scene& scene)
+      : sim_(&borrowed), block_size_(scene.block_size), walls_(scene.walls), restitution_(scene.restitution),
+        conservative_(false) {}
+
+  // Python forces as solvers after the scene's own.
+  static void add_python_forces(Simulation<Real>& sim, const Forces& forces) {
+    for (const auto& [name, fn] : forces) sim.add_solver(std::make_unique<PythonForce<Real>>(name, fn));
+  }
+
+  bool borrowed() const override { return !owned_; }
+  void detach() override { sim_ = nullptr; }
+
   // The initial forces; once, before anything else (the Python object exists by then, for the forces).
   void start() override {
-    sim_.start();
-    conservative_ = std::all_of(sim_.solvers().begin(), sim_.solvers().end(),
+    live().start();
+    conservative_ = std::all_of(live().solvers().begin(), live().solvers().end(),
                                 [](const auto& s) { return s->conserves_energy(); }) &&
                     (!walls_ || restitution_ == 1);
     initial_energy_ = energies().total;
   }
 
-  void step(std::optional<double> land_at) override { sim_.step(land_at); }
-  double time() const override { return sim_.time(); }
-  std::uint64_t steps() const override { return sim_.step_count(); }
-  std::uint64_t epoch() const override { return sim_.epoch(); }
-  std::size_t size() const override { return sim_.particles().size(); }
-  double last_dt() const override { return sim_.last_dt(); }
-  double proposed_dt() const override { return sim_.proposed_dt(); }
-  bool adaptive() const override { return sim_.settings().adaptive; }
-  double dt() const override { return sim_.settings().dt; }
+  void step(std::optional<double> land_at) override { live().step(land_at); }
+  double time() const override { return live().time(); }
+  std::uint64_t steps() const override { return live().step_count(); }
+  std::uint64_t epoch() const override { return live().epoch(); }
+  std::size_t size() const override { return live().particles().size(); }
+  double last_dt() const override { return live().last_dt(); }
+  double proposed_dt() const override { return live().proposed_dt(); }
+  bool adaptive() const override { return live().settings().adaptive; }
+  double dt() const override { return live().settings().dt; }
   std::string precision() const override { return std::is_same_v<Real, float> ? "float" : "double"; }
 
   nb::object field(nb::handle owner, const std::string& name, int component) override {
@@ -175,7 +192,7 @@ class TypedSimulation final : public AnySimulation {
   }
   nb::list fields() override {
     nb::list out;
-    auto& p = sim_.particles();
+    auto& p = live().particles();
     for (const auto& f : p.fields()) out.append(nb::make_tuple(std::string(f.name), f.components, "real", f.internal));
     for (const auto& f : p.int_fields()) out.append(nb::make_tuple(std::string(f.name), 1, "int", f.internal));
     out.append(nb::make_tuple("id", 1, "id", false));
@@ -187,8 +204,8 @@ class TypedSimulation final : public AnySimulation {
   nb::dict diagnostics() override {
     const Energies e = energies();
     nb::dict d;
-    d["time"] = sim_.time();
-    d["step"] = sim_.step_count();
+    d["time"] = live().time();
+    d["step"] = live().step_count();
     d["kinetic_energy"] = e.kinetic;
     d["potential_energy"] = e.potential;
     d["total_energy"] = e.total;
@@ -200,30 +217,30 @@ class TypedSimulation final : public AnySimulation {
       d[fmt::format("angular_momentum_{}", axes[k]).c_str()] = e.angular[static_cast<std::size_t>(k)];
     std::vector<double> row;
     std::vector<std::string> names;
-    for (const auto& s : sim_.solvers()) {
+    for (const auto& s : live().solvers()) {
       for (const auto& c : s->diagnostic_columns()) names.push_back(c);
-      s->add_diagnostics(sim_.particles(), block_size_, row);
+      s->add_diagnostics(live().particles(), block_size_, row);
     }
     for (std::size_t k = 0; k < names.size() && k < row.size(); ++k) d[names[k].c_str()] = row[k];
     return d;
   }
   nb::dict metrics() override {
     NamedValues values;
-    for (const auto& s : sim_.solvers()) s->add_metrics(values);
-    if (sim_.order().active()) values.emplace_back("sorts", double(sim_.order().sorts()));
+    for (const auto& s : live().solvers()) s->add_metrics(values);
+    if (live().order().active()) values.emplace_back("sorts", double(live().order().sorts()));
     nb::dict d;
     for (const auto& [k, v] : values) d[k.c_str()] = v;
     return d;
   }
   nb::dict phases() override {
     nb::dict d;
-    for (const auto& [k, v] : sim_.timers().phases()) d[k.c_str()] = v;
+    for (const auto& [k, v] : live().timers().phases()) d[k.c_str()] = v;
     return d;
   }
   // One frame file as the run's frame writer writes it (the same io:: writer).
   void write_frame(const std::string& path, const std::string& format) override {
-    if (format == "vtp") io::write_vtp(path, sim_.particles(), sim_.time());
-    else if (format == "csv") io::write_csv(path, sim_.particles(), sim_.time());
+    if (format == "vtp") io::write_vtp(path, live().particles(), live().time());
+    else if (format == "csv") io::write_csv(path, live().particles(), live().time());
     else throw nb::value_error(fmt::format("format '{}': give \"vtp\" or \"csv\"", format).c_str());
   }
 
@@ -234,7 +251,7 @@ class TypedSimulation final : public AnySimulation {
     const std::uint64_t* id = nullptr;
   };
   Located locate(const std::string& name, int component) {
-    auto& p = sim_.particles();
+    auto& p = live().particles();
     if (name == "id") {
       if (component != 0) throw nb::index_error("field 'id' has one component");
       return {nullptr, nullptr, p.id.data()};
@@ -262,7 +279,7 @@ class TypedSimulation final : public AnySimulation {
     std::array<double, 3> momentum{}, angular{};
   };
   Energies energies() const {
-    const auto& p = sim_.particles();
+    const auto& p = live().particles();
     Energies e;
     for (std::size_t i = 0; i < p.size(); ++i) {
       const double m = p.mass[i];
@@ -272,12 +289,26 @@ class TypedSimulation final : public AnySimulation {
       e.momentum[0] += m * vx, e.momentum[1] += m * vy, e.momentum[2] += m * vz;
       e.angular[0] += m * (y * vz - z * vy), e.angular[1] += m * (z * vx - x * vz), e.angular[2] += m * (x * vy - y * vx);
     }
-    for (const auto& s : sim_.solvers()) e.potential += s->potential_energy(p, block_size_);
+    for (const auto& s : live().solvers()) e.potential += s->potential_energy(p, block_size_);
     e.total = e.kinetic + e.potential;
     return e;
   }
 
-  Simulation<Real> sim_;
+  // Constructs the owned simulation in place from a function's result (no move).
+  template <class F>
+  struct BuiltBy {
+    F make;
+    operator std::invoke_result_t<F>() { return make(); }  // NOLINT(google-explicit-constructor)
+  };
+  Simulation<Real>& live() const {
+    if (sim_ == nullptr)
+      throw std::runtime_error("this Simulation was a run's (swirl.run's callback) and the run has ended: it is gone "
+                               "(keep copies of what you need: .copy(), sorted_by_id())");
+    return *sim_;
+  }
+
+  std::optional<Simulation<Real>> owned_;
+  Simulation<Real>* sim_ = nullptr;
   std::size_t block_size_;
   bool walls_;
   double restitution_;
@@ -356,6 +387,9 @@ class PySimulation {
   // state between a drift and a kick: the simulation refuses to go on.
   void one_step(std::optional<double> land) {
     if (!broken_.empty()) throw std::runtime_error(broken_);
+    if (sim_->borrowed())
+      throw std::logic_error("this Simulation is a run's (swirl.run's callback): the run steps it; a callback reads "
+                             "and changes fields, and stops the run by returning False");
     if (!started_) throw std::logic_error("the simulation was not started (swirl.Simulation starts it)");
     try {
       nb::gil_scoped_release release;
@@ -438,6 +472,16 @@ std::unique_ptr<AnySimulation> from_arrays(const PyScene& base, Rows positions, 
 }
 
 }  // namespace
+
+template <class Real>
+nb::object borrow_simulation(Simulation<Real>& sim, const scene::Scene& scene, const Forces& forces) {
+  TypedSimulation<Real>::add_python_forces(sim, forces);
+  return nb::cast(new PySimulation(std::make_unique<TypedSimulation<Real>>(sim, scene)), nb::rv_policy::take_ownership);
+}
+template nb::object borrow_simulation<float>(Simulation<float>&, const scene::Scene&, const Forces&);
+template nb::object borrow_simulation<double>(Simulation<double>&, const scene::Scene&, const Forces&);
+
+void detach_simulation(nb::handle native) { nb::cast<PySimulation&>(native).sim().detach(); }
 
 void bind_simulation(nb::module_& m) {
   nb::class_<PySimulation>(m, "Simulation")

@@ -92,3 +92,69 @@ def test_progress_callback_can_stop(swirl, sph_scene, tmp_path):
 
     summary = swirl.run(sph_scene, tmp_path / "run", steps=50, progress=progress)
     assert summary["interrupted"] and summary["steps"] == 3 and seen[-1] == 3
+
+
+def test_run_with_a_callback_steers_and_resumes_bit_identically(swirl, sph_scene, tmp_path):
+    """A callback that changes the state every 5 steps, in a run that writes its folder: a run stopped at step 10
+    and resumed with the same callback ends byte-identical to the uninterrupted one."""
+    import numpy as np
+
+    def kick(sim):
+        assert sim.steps % 5 == 0
+        sim.particles.velocity.x += 0.01  # a steady push, through fresh views
+        return True
+
+    plain = swirl.run(sph_scene, tmp_path / "plain", steps=20)
+    whole = swirl.run(sph_scene, tmp_path / "whole", steps=20, callback=kick, every=5)
+    assert whole["steps"] == 20 and whole["error"] == ""
+    assert not filecmp.cmp(tmp_path / "plain" / "particles_000002.vtp", tmp_path / "whole" / "particles_000002.vtp",
+                           shallow=False)
+    first = swirl.run(sph_scene, tmp_path / "part", steps=10, checkpoint_every_steps=5, callback=kick, every=5)
+    assert first["steps"] == 10 and plain["steps"] == 20
+    swirl.resume(tmp_path / "part", steps=10, callback=kick, every=5)
+    for name in ("particles_000002.vtp", "diagnostics.csv"):
+        assert filecmp.cmp(tmp_path / "whole" / name, tmp_path / "part" / name, shallow=False), name
+
+    # At times: every 0.002 s of simulated time (dt = 4e-4 s: steps 5, 10, ...).
+    seen = []
+    swirl.run(sph_scene, tmp_path / "timed", steps=20, callback=lambda s: seen.append(round(s.time, 6)), every=0.002)
+    np.testing.assert_allclose(seen, [0.002, 0.004, 0.006, 0.008], rtol=1e-9)
+
+
+def test_run_callback_stops_raises_and_is_cut_off(swirl, sph_scene, tmp_path):
+    kept = []
+
+    def stop_at_6(sim):
+        kept.append(sim)
+        with pytest.raises(Exception, match="the run steps it"):
+            sim.step()
+        return sim.steps < 6
+
+    summary = swirl.run(sph_scene, tmp_path / "stop", steps=50, callback=stop_at_6, every=3)
+    assert summary["interrupted"] and summary["steps"] == 6
+    assert summary["last_checkpoint"].endswith("checkpoint_000000000006.swc")
+    with pytest.raises(RuntimeError, match="the run has ended"):
+        kept[0].particles.position.x  # noqa: B018  (the run's particles are gone)
+
+    def broken(sim):
+        if sim.steps == 4:
+            raise ZeroDivisionError("from the callback")
+
+    with pytest.raises(ZeroDivisionError, match="from the callback"):
+        swirl.run(sph_scene, tmp_path / "raise", steps=50, callback=broken, every=2)
+    assert list((tmp_path / "raise" / "checkpoints").glob("*.swc"))
+    with pytest.raises(ValueError, match="give a callback too"):
+        swirl.run(sph_scene, tmp_path / "x", steps=2, every=2)
+    with pytest.raises(ValueError, match="every=0"):
+        swirl.run(sph_scene, tmp_path / "y", steps=2, callback=print, every=0)
+
+
+def test_run_with_a_python_force(swirl, tiny_scene, tmp_path):
+    """A force written in Python inside a run folder's run: timed as its own phase, and it acts."""
+    def lift(sim, t):
+        sim.particles.acceleration.z += 9.81  # cancels the scene's gravity
+
+    summary = swirl.run(tiny_scene, tmp_path / "lift", steps=10, forces={"lift": lift})
+    assert "forces.python.lift" in summary["phases"]
+    final = swirl.read_diagnostics(tmp_path / "lift")
+    assert abs(final["momentum_z"][-1]) < 1e-9  # gravity cancelled: nothing falls

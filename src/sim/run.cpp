@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <type_traits>
 #include <sstream>
 
 #include <unistd.h>
@@ -556,6 +557,12 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   const std::uint64_t hash = scene::scene_hash(scene);
 
   Simulation<Real> sim = build_simulation<Real>(scene);
+  std::vector<std::shared_ptr<Observer<Real>>> added;
+  if constexpr (std::is_same_v<Real, float>) {
+    if (options.extend_float) added = options.extend_float(sim);
+  } else {
+    if (options.extend_double) added = options.extend_double(sim);
+  }
   // Only now, so that a scene refused while its particles are built leaves no
   // empty output directory behind; nothing has been run yet.
   io::ensure_writable_directory(options.out_dir, first_output_bytes);
@@ -593,6 +600,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   summary.time_unit = std::string(time_unit);
   auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps, time_unit);
   std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get(), guard.get()};
+  for (const auto& o : added) observers.push_back(o.get());
   auto collect = [&](NamedValues& values) {
     end.save(values);
     save_clock(sim.clock(), values);

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
@@ -35,7 +36,27 @@
 #include "swirl/scene/scene.hpp"
 #include "swirl/sim/blow_up.hpp"
 
+namespace swirl {
+template <class Real>
+class Simulation;
+}  // namespace swirl
+
 namespace swirl::sim {
+
+template <class Real>
+class Observer;
+
+// What a caller adds to a run (the Python module: forces and callbacks written
+// in Python). Called once with the run's simulation, built and not yet started
+// or resumed: it may add solvers (they act from the first force evaluation)
+// and returns observers. Those act after every step after the frame writer,
+// the diagnostics log and the guard, and before the checkpointer and the
+// progress report: a checkpoint holds what they changed, so a resumed run goes
+// on exactly as the uninterrupted one. Their save_state/load_state go into
+// checkpoints like the run's own observers'. They may outlive the run; the
+// simulation does not.
+template <class Real>
+using RunExtension = std::function<std::vector<std::shared_ptr<Observer<Real>>>(Simulation<Real>& sim)>;
 
 // Records a file in the run folder's manifest before it is written and returns
 // its full path; throws io::RunFolderError for a file that exists and is not
@@ -77,6 +98,11 @@ struct RunOptions {
   // Called after each frame has been written (e.g. to render it while the run
   // goes on). An exception thrown here stops the run like a write failure.
   FrameHook on_frame;
+
+  // Solvers and observers a caller adds (RunExtension), for float and for
+  // double scenes; the one of the scene's precision is called, if set.
+  RunExtension<float> extend_float;
+  RunExtension<double> extend_double;
 
   // What a failed blow-up check does (stop, or warn and go on).
   OnBlowUp on_blow_up = OnBlowUp::Stop;
