@@ -1,5 +1,6 @@
 #include "swirl/gravity/initial_conditions.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
@@ -60,6 +61,72 @@ void add_plummer(Sample& s, std::size_t n, SplitMix64& rng, double mass_cut, dou
   }
 }
 
+// The Hernquist isotropic distribution function of the binding energy
+// ε = Ψ − v²/2 in units of GM/a, 0 < ε < 1, without its constant factor
+// M/(8√2 π³ a³ (GM/a)^{3/2}) (Hernquist 1990, eq. 17), q = √ε:
+//   f ∝ (1 − q²)^{−5/2} [3 asin q + q (1 − q²)^{1/2} (1 − 2q²)(8q⁴ − 8q² − 3)].
+// For small q the bracket cancels to O(q⁵): a rounding error there is far
+// below the rejection bound near the peak, so it changes nothing.
+double hernquist_df(double e) {
+  if (!(e > 0)) return 0;
+  const double q = std::sqrt(e);
+  const double bracket = 3 * std::asin(q) + q * std::sqrt(1 - e) * (1 - 2 * e) * (8 * e * e - 8 * e - 3);
+  return std::max(0.0, bracket) / std::pow(1 - e, 2.5);
+}
+
+// The largest value of a unimodal g on (0, 1), by golden-section search.
+template <class G>
+double unimodal_max(G g) {
+  const double inv_phi = 0.6180339887498949;
+  double lo = 0, hi = 1;
+  double x1 = hi - inv_phi * (hi - lo), x2 = lo + inv_phi * (hi - lo);
+  double g1 = g(x1), g2 = g(x2);
+  for (int k = 0; k < 48; ++k) {  // the bracket shrinks to 1e-10
+    if (g1 < g2) {
+      lo = x1, x1 = x2, g1 = g2;
+      x2 = lo + inv_phi * (hi - lo), g2 = g(x2);
+    } else {
+      hi = x2, x2 = x1, g2 = g1;
+      x1 = hi - inv_phi * (hi - lo), g1 = g(x1);
+    }
+  }
+  return std::max(g1, g2);
+}
+
+// One Hernquist halo, G = M = 1, scale radius 1 (structural units), centre of mass not yet removed.
+void add_hernquist(Sample& s, std::size_t n, SplitMix64& rng, double mass_cut) {
+  for (std::size_t i = 0; i < n; ++i) {
+    // Enclosed mass m = r²/(1 + r)² inverted: r = √m/(1 − √m); m > 0 keeps r > 0 (Ψ < 1).
+    double m = 0;
+    while (!(m > 0)) m = mass_cut * rng.uniform();
+    const double r = std::sqrt(m) / (1 - std::sqrt(m));
+    const double psi = 1 / (1 + r);
+    // v = x·v_esc, v_esc = √(2Ψ): the density of x is ∝ x² f(Ψ(1 − x²)) on (0, 1).
+    const auto density = [psi](double x) { return x * x * hernquist_df(psi * (1 - x * x)); };
+    const double bound = 1.1 * unimodal_max(density);
+    double x = 0, y = 1;
+    while (y > density(x)) {
+      x = rng.uniform();
+      y = bound * rng.uniform();
+    }
+    s.x.push_back(isotropic(rng, r));
+    s.v.push_back(isotropic(rng, x * std::sqrt(2 * psi)));
+    s.m.push_back(1 / double(n));
+  }
+}
+
+// The centre of mass of particles [begin, end).
+V3 centre_of_mass(const Sample& s, std::size_t begin, std::size_t end) {
+  double mass = 0;
+  V3 mx{};
+  for (std::size_t i = begin; i < end; ++i) {
+    mass += s.m[i];
+    for (std::size_t a = 0; a < 3; ++a) mx[a] += s.m[i] * s.x[i][a];
+  }
+  for (double& c : mx) c /= mass;
+  return mx;
+}
+
 // Shifts particles [begin, end) so that their centre of mass is at x0 moving with v0.
 void recentre(Sample& s, std::size_t begin, std::size_t end, const V3& x0, const V3& v0) {
   double mass = 0;
@@ -102,6 +169,30 @@ ParticleSet<Real> plummer(std::size_t n, std::uint64_t seed, const PlummerOption
   Sample s;
   add_plummer(s, n, rng, options.mass_cut, 1.0);
   recentre(s, 0, n, {}, {});
+  return to_particles<Real>(s);
+}
+
+template <class Real>
+ParticleSet<Real> hernquist(std::size_t n, std::uint64_t seed, const HernquistOptions& options) {
+  require_particles("hernquist", n);
+  const double a = options.scale_radius;
+  require(a > 0 && std::isfinite(a), "hernquist", "scale_radius", a, "finite and > 0");
+  require(options.mass_cut > 0 && options.mass_cut < 1, "hernquist", "mass_cut", options.mass_cut, "in (0, 1)");
+  SplitMix64 rng(seed);
+  Sample s;
+  add_hernquist(s, n, rng, options.mass_cut);
+  // Structural units (a = 1) → scale radius a: lengths × a, velocities × (GM/a)^{1/2}.
+  const double speed = 1 / std::sqrt(a);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < 3; ++k) {
+      s.x[i][k] *= a;
+      s.v[i][k] *= speed;
+    }
+  // Only the velocity of the centre of mass is removed: the ρ ∝ r⁻⁴ tail moves the
+  // sample's centre of mass by about √(2 a r_max / 3N) from the cusp (0.05 a at
+  // N = 65 536), and the cusp, not that point, is the halo's centre.
+  const V3 x0 = centre_of_mass(s, 0, n);
+  recentre(s, 0, n, x0, {});
   return to_particles<Real>(s);
 }
 
@@ -187,6 +278,8 @@ ParticleSet<Real> plummer_collision(std::size_t n, std::uint64_t seed, const Col
 
 template ParticleSet<float> plummer<float>(std::size_t, std::uint64_t, const PlummerOptions&);
 template ParticleSet<double> plummer<double>(std::size_t, std::uint64_t, const PlummerOptions&);
+template ParticleSet<float> hernquist<float>(std::size_t, std::uint64_t, const HernquistOptions&);
+template ParticleSet<double> hernquist<double>(std::size_t, std::uint64_t, const HernquistOptions&);
 template ParticleSet<float> uniform_sphere<float>(std::size_t, std::uint64_t, double, double);
 template ParticleSet<double> uniform_sphere<double>(std::size_t, std::uint64_t, double, double);
 template ParticleSet<float> uniform_cube<float>(std::size_t, std::uint64_t, double, double);

@@ -642,6 +642,20 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
       k.push_back(field(SourceKey{.key = "mass_cut", .range = kFraction, .doc = "of each sphere, as for `plummer`"},
                         collision(&gravity::CollisionOptions::mass_cut)));
       break;
+    case Model::Hernquist: {
+      const auto halo = [](auto member) {
+        return [member](auto& src) { auto* m = std::get_if<StellarSource>(&src); return m ? &(m->hernquist.*member) : nullptr; };
+      };
+      k.push_back(field(SourceKey{.key = "scale_radius", .unit = "length", .range = kPositive,
+                                  .doc = "a: the density falls as r⁻¹ inside it and r⁻⁴ outside; 1/3 gives E = −1/4 "
+                                         "(Hénon units) for the whole model",
+                                  .default_doc = "1/3"},
+                        halo(&gravity::HernquistOptions::scale_radius)));
+      k.push_back(field(SourceKey{.key = "mass_cut", .range = Range{0, 1, true, true},
+                                  .doc = "the fraction of the infinite model's mass kept (0.99: out to 199 a)"},
+                        halo(&gravity::HernquistOptions::mass_cut)));
+      break;
+    }
   }
   k.push_back(field(SourceKey{.key = "offset", .unit = "length", .doc = "moves the whole model"},
                     in_source(&StellarSource::offset)));

@@ -117,6 +117,7 @@ class Filler {
       case Model::UniformCube: model = gravity::uniform_cube<Real>(s.count, s.seed, s.size, s.mass); break;
       case Model::ColdCollapse: model = gravity::cold_collapse<Real>(s.count, s.seed); break;
       case Model::PlummerCollision: model = gravity::plummer_collision<Real>(s.count, s.seed, s.collision); break;
+      case Model::Hernquist: model = gravity::hernquist<Real>(s.count, s.seed, s.hernquist); break;
     }
     for (std::size_t n = 0; n < model.size(); ++n)
       put(model.position.get(n).template cast<double>() + s.offset,

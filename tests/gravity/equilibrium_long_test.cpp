@@ -87,5 +87,51 @@ TYPED_TEST(EquilibriumTest, PlummerSphereStaysInEquilibriumForTenCrossingTimes) 
   }
 }
 
+// A Hernquist halo (a = 1/3, 2048 particles, double, the global scheme) keeps
+// its shape for two orbits at its half-mass radius (t = 12.5; an orbit there
+// takes 6.4): its velocities come from the model's distribution function, so
+// only sampling noise, softening and two-body relaxation can move it.
+// ε = 0.01 and Δt = 1/128. The fastest motion is in the cusp, where the pull
+// is about GM/a² whatever r: at r ≈ ε, ω² ≈ GM/(a² ε) = 900, and the
+// leapfrog's swing (ωΔt)²/4 = 1.4·10⁻² for those few particles; the whole
+// halo's energy error is far smaller, so the bound is empirical: 5·10⁻³, three
+// times the measured 1.5·10⁻³. The virial ratio within 0.1 of its start
+// (measured 0.043), the Lagrangian radii at 25, 50 and 75 % within 10 %.
+TEST(HernquistEquilibrium, HaloKeepsItsShapeForTwoOrbits) {
+  using Real = double;
+  GravitySettings g;
+  g.opening = 0.5;
+  g.softening = 0.01;
+  SimulationSettings s;
+  s.dt = 1.0 / 128;
+  s.block_size = 256;
+  Simulation<Real> sim(hernquist<Real>(2048, 2025), s);
+  sim.add_solver(std::make_unique<GravityForce<Real>>(g));
+  sim.start();
+  const auto lagrangian = [](const ParticleSet<Real>& p, const Vec3d& centre) {
+    std::vector<double> r(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) r[i] = norm(p.position.get(i).template cast<double>() - centre);
+    std::sort(r.begin(), r.end());
+    return std::vector<double>{r[r.size() / 4], r[r.size() / 2], r[3 * r.size() / 4]};
+  };
+  const Diagnostics d0 = diagnose(sim.particles());
+  const std::vector<double> r0 = lagrangian(sim.particles(), d0.centre_of_mass);
+  double worst_energy = 0, worst_virial = 0;
+  for (int step = 1; step <= 1600; ++step) {
+    sim.step();
+    if (step % 32 != 0) continue;
+    const Diagnostics d = diagnose(sim.particles());
+    worst_energy = std::max(worst_energy, std::abs(d.total / d0.total - 1));
+    worst_virial = std::max(worst_virial, std::abs(d.virial_ratio - d0.virial_ratio));
+  }
+  const Diagnostics end = diagnose(sim.particles());
+  const std::vector<double> r1 = lagrangian(sim.particles(), end.centre_of_mass);
+  EXPECT_LT(worst_energy, 5e-3);
+  EXPECT_LT(worst_virial, 0.1);
+  for (std::size_t k = 0; k < r0.size(); ++k) EXPECT_NEAR(r1[k] / r0[k], 1.0, 0.1) << "Lagrangian radius " << k;
+  RecordProperty("energy_error", std::to_string(worst_energy));
+  RecordProperty("virial_change", std::to_string(worst_virial));
+}
+
 }  // namespace
 }  // namespace swirl::gravity

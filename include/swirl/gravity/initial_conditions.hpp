@@ -30,6 +30,24 @@ struct PlummerOptions {
 template <class Real>
 ParticleSet<Real> plummer(std::size_t n, std::uint64_t seed, const PlummerOptions& options = {});
 
+// Hernquist (1990, ApJ 356, 359) halo: density ρ(r) = M a / (2π r (r + a)³),
+// enclosed mass M r²/(r + a)², potential −GM/(r + a). Radius from the inverted
+// mass profile r = a √m / (1 − √m) with m uniform in (0, mass_cut) (its ρ ∝ r⁻⁴
+// tail holds 1 % of the mass beyond 199 a); speed from the isotropic
+// distribution function (Hernquist's eq. 17) at that radius, by von Neumann
+// rejection of v ∈ (0, v_esc) under a bound found by golden-section search
+// (the density of v is unimodal); isotropic directions; equal masses 1/N
+// (M = 1 for the particles kept); the cusp at the origin and the centre-of-mass
+// velocity removed (the heavy tail moves the centre of mass off the cusp by
+// ~√(2 a r_max/3N)). G = M = 1; scale_radius = 1/3 puts the untruncated model
+// in Hénon units (E = −GM²/(12a) = −1/4).
+struct HernquistOptions {
+  double scale_radius = 1.0 / 3.0;  // a > 0
+  double mass_cut = 0.99;           // in (0, 1)
+};
+template <class Real>
+ParticleSet<Real> hernquist(std::size_t n, std::uint64_t seed, const HernquistOptions& options = {});
+
 // Uniform sphere of radius R and mass M centred at the origin, at rest.
 template <class Real>
 ParticleSet<Real> uniform_sphere(std::size_t n, std::uint64_t seed, double radius = 1, double mass = 1);
@@ -65,6 +83,8 @@ ParticleSet<Real> plummer_collision(std::size_t n, std::uint64_t seed, const Col
 
 extern template ParticleSet<float> plummer<float>(std::size_t, std::uint64_t, const PlummerOptions&);
 extern template ParticleSet<double> plummer<double>(std::size_t, std::uint64_t, const PlummerOptions&);
+extern template ParticleSet<float> hernquist<float>(std::size_t, std::uint64_t, const HernquistOptions&);
+extern template ParticleSet<double> hernquist<double>(std::size_t, std::uint64_t, const HernquistOptions&);
 extern template ParticleSet<float> uniform_sphere<float>(std::size_t, std::uint64_t, double, double);
 extern template ParticleSet<double> uniform_sphere<double>(std::size_t, std::uint64_t, double, double);
 extern template ParticleSet<float> uniform_cube<float>(std::size_t, std::uint64_t, double, double);

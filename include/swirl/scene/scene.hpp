@@ -79,7 +79,7 @@ struct ListSource {
 // A self-gravitating model from gravity/initial_conditions.hpp (G = 1 units),
 // moved by `offset` and given the extra bulk `velocity`.
 struct StellarSource {
-  enum class Model { Plummer, UniformSphere, UniformCube, ColdCollapse, PlummerCollision };
+  enum class Model { Plummer, UniformSphere, UniformCube, ColdCollapse, PlummerCollision, Hernquist };
   Model model = Model::Plummer;
   std::size_t count = 0;
   std::uint64_t seed = 1;
@@ -87,17 +87,19 @@ struct StellarSource {
   double mass = 1;   // uniform_sphere, uniform_cube: total mass
   gravity::PlummerOptions plummer;      // plummer
   gravity::CollisionOptions collision;  // plummer_collision
+  gravity::HernquistOptions hernquist;  // hernquist
   Vec3d offset{};
   Vec3d velocity{};
 };
 
 // The stellar models' names, which are also their [[particles]] kinds.
-inline constexpr std::array<EnumName<StellarSource::Model>, 5> kStellarModelNames{{
+inline constexpr std::array<EnumName<StellarSource::Model>, 6> kStellarModelNames{{
     {"plummer", StellarSource::Model::Plummer},
     {"uniform_sphere", StellarSource::Model::UniformSphere},
     {"uniform_cube", StellarSource::Model::UniformCube},
     {"cold_collapse", StellarSource::Model::ColdCollapse},
     {"plummer_collision", StellarSource::Model::PlummerCollision},
+    {"hernquist", StellarSource::Model::Hernquist},
 }};
 
 using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource>;
