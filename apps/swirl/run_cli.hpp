@@ -3,8 +3,9 @@
 // table: 0 done, 1 the run failed, 2 bad input, 130/143 stopped by a signal).
 // Errors are printed to stderr, never thrown. The executable's main() and the
 // Python module (swirl.cli, swirl.bench, the `swirl` command pip installs)
-// call it; it changes no process state a caller keeps (thread count aside,
-// which a caller restores: see python/src/cli.cpp).
+// call it. What it leaves changed in the process: the SIGINT/SIGTERM handlers
+// (`swirl run` installs its own) and the thread count (--threads, the bench
+// suites); a caller that lives on restores them (python/src/cli.cpp).
 #pragma once
 
 namespace swirl::cli {
