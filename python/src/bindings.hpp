@@ -6,7 +6,8 @@
 //                   with the GIL released, its fields as zero-copy numpy arrays
 //   run.cpp         sim::run_scene (frames, diagnostics, checkpoints, resume) as
 //                   `swirl run` calls it, and the summary as a dict
-//   render.cpp      a run folder's frame drawn as `swirl render` draws it
+//   render.cpp      a run folder's frame drawn as `swirl render` draws it, and a
+//                   simulation's current state drawn the same way
 //   cli.cpp         the whole command-line tool in-process (swirl.cli, swirl.bench)
 #pragma once
 
@@ -16,6 +17,7 @@
 
 #include <nanobind/nanobind.h>
 
+#include "swirl/render/run_renderer.hpp"
 #include "swirl/scene/scene.hpp"
 
 namespace swirl {
@@ -37,6 +39,11 @@ using Forces = std::vector<std::pair<std::string, nb::object>>;
 template <class Real>
 nb::object borrow_simulation(Simulation<Real>& sim, const scene::Scene& scene, const Forces& forces);
 void detach_simulation(nb::handle native);
+
+// simulation.cpp: a _swirl.Simulation's current state as a picture's frame,
+// and what its scene says for pictures (render.cpp draws them).
+render::Frame simulation_frame(nb::handle native);
+render::RunInfo simulation_run_info(nb::handle native);
 
 // A validated scene, as the loader returns it.
 struct PyScene {

@@ -108,6 +108,9 @@ class AnySimulation {
   // (name, components, kind "real" | "int" | "id", internal) for every field.
   virtual nb::list fields() = 0;
   virtual nb::dict diagnostics() = 0;
+  // The current state as a picture's frame (positions, velocity, mass, density, pressure; time).
+  virtual render::Frame frame() = 0;
+  virtual const render::RunInfo& run_info() const = 0;
   virtual nb::dict metrics() = 0;
   virtual nb::dict phases() = 0;
   virtual void write_frame(const std::string& path, const std::string& format) = 0;
@@ -119,7 +122,8 @@ class TypedSimulation final : public AnySimulation {
   TypedSimulation(const scene::Scene& scene, const Forces& forces, const ExtraFields& fields,
                   const ExtraIntFields& int_fields)
       : owned_(std::in_place, BuiltBy{[&] { return sim::build_simulation<Real>(scene); }}), sim_(&*owned_),
-        block_size_(scene.block_size), walls_(scene.walls), restitution_(scene.restitution) {
+        block_size_(scene.block_size), walls_(scene.walls), restitution_(scene.restitution),
+        run_info_(picture_info(scene)) {
     add_python_forces(live(), forces);
     // Before start(): storage order is still the order given (a list source), and the
     // first reorder carries the field along like every other.
@@ -140,7 +144,7 @@ class TypedSimulation final : public AnySimulation {
   // detach() cuts this object off from it when the run ends.
   TypedSimulation(Simulation<Real>& borrowed, const scene::Scene& scene)
       : sim_(&borrowed), block_size_(scene.block_size), walls_(scene.walls), restitution_(scene.restitution),
-        conservative_(false) {}
+        conservative_(false), run_info_(picture_info(scene)) {}
 
   // Python forces as solvers after the scene's own.
   static void add_python_forces(Simulation<Real>& sim, const Forces& forces) {
@@ -237,6 +241,28 @@ class TypedSimulation final : public AnySimulation {
     for (const auto& [k, v] : live().timers().phases()) d[k.c_str()] = v;
     return d;
   }
+  render::Frame frame() override {
+    const auto& p = live().particles();
+    render::Frame f;
+    f.file = "<simulation>";
+    f.time = live().time();
+    const std::size_t n = p.size();
+    f.positions.resize(n);
+    f.velocity.resize(n);
+    f.mass.resize(n);
+    f.density.resize(n);
+    f.pressure.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      f.positions[i] = p.position.get(i).template cast<double>();
+      f.velocity[i] = p.velocity.get(i).template cast<double>();
+      f.mass[i] = p.mass[i];
+      f.density[i] = p.density[i];
+      f.pressure[i] = p.pressure[i];
+    }
+    return f;
+  }
+  const render::RunInfo& run_info() const override { return run_info_; }
+
   // One frame file as the run's frame writer writes it (the same io:: writer).
   void write_frame(const std::string& path, const std::string& format) override {
     if (format == "vtp") io::write_vtp(path, live().particles(), live().time());
@@ -307,6 +333,12 @@ class TypedSimulation final : public AnySimulation {
     return *sim_;
   }
 
+  static render::RunInfo picture_info(const scene::Scene& scene) {
+    render::RunInfo info = render::run_info_of(scene);
+    info.scene_name = std::filesystem::path(scene.file).stem().string();
+    return info;
+  }
+
   std::optional<Simulation<Real>> owned_;
   Simulation<Real>* sim_ = nullptr;
   std::size_t block_size_;
@@ -314,6 +346,7 @@ class TypedSimulation final : public AnySimulation {
   double restitution_;
   bool conservative_ = true;
   double initial_energy_ = 0;
+  render::RunInfo run_info_;
 };
 
 std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene, const Forces& forces,
@@ -482,6 +515,8 @@ template nb::object borrow_simulation<float>(Simulation<float>&, const scene::Sc
 template nb::object borrow_simulation<double>(Simulation<double>&, const scene::Scene&, const Forces&);
 
 void detach_simulation(nb::handle native) { nb::cast<PySimulation&>(native).sim().detach(); }
+render::Frame simulation_frame(nb::handle native) { return nb::cast<PySimulation&>(native).sim().frame(); }
+render::RunInfo simulation_run_info(nb::handle native) { return nb::cast<PySimulation&>(native).sim().run_info(); }
 
 void bind_simulation(nb::module_& m) {
   nb::class_<PySimulation>(m, "Simulation")

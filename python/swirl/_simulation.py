@@ -121,7 +121,7 @@ class Simulation:
         r = np.hypot(sim.particles.position.x, sim.particles.position.y)   # views, no copy
     """
 
-    __slots__ = ("_native", "_scene", "__weakref__")
+    __slots__ = ("_native", "_scene", "_renderer", "_renderer_key", "__weakref__")
 
     def __init__(self, scene, forces=None):
         if isinstance(scene, (str, os.PathLike)):
@@ -321,6 +321,32 @@ class Simulation:
         if format is None:
             format = os.path.splitext(path)[1].lstrip(".").lower()
         self._native.write_frame(path, format)
+
+    def render(self, *, view="front", color=None, size=(1280, 720), range=None, projection=None, png=None):
+        """Draws the current state as ``swirl render`` draws a frame; returns an (height, width, 3) uint8 RGB image.
+
+        No run folder or frame file is needed. The arguments are ``swirl.render``'s:
+        ``view`` ``"front"``, ``"top"`` or ``"iso"``; ``color`` ``"speed"``,
+        ``"density"``, ``"pressure"`` or ``"mass"`` (default: density for gravity
+        scenes, else speed); ``size`` (width, height) in pixels, each >= 64;
+        ``range`` (lo, hi) of the colours; ``projection`` ``"ortho"`` or
+        ``"perspective"``; ``png`` also writes the picture there. The first call
+        fixes the camera and the colours from the state it sees (as a run's first
+        frame does for ``swirl render``); later calls with the same arguments keep
+        them, so pictures taken from a callback make a movie that does not flicker.
+        Other arguments fix them anew.
+        """
+        try:
+            width, height = (int(x) for x in size)
+        except (TypeError, ValueError):
+            raise ValueError(f"size={size!r}: give (width, height) in pixels") from None
+        if range is not None:
+            range = tuple(float(x) for x in range)
+        key = (view, color, width, height, range, projection)
+        if getattr(self, "_renderer_key", None) != key:
+            self._renderer = _swirl.StateRenderer(self._native, view, projection, color, width, height, range)
+            self._renderer_key = key
+        return self._renderer.draw(self._native, None if png is None else os.fspath(png))["image"]
 
     def __repr__(self):
         return (f"<swirl.Simulation {self._scene.file!r}: {self.count} particles ({self.precision}), "

@@ -88,3 +88,23 @@ def test_render_matches_the_cli(swirl, sph_scene, tmp_path):
         swirl.render(out, 7)
     with pytest.raises(ValueError):
         swirl.render(out, view="sideways")
+
+
+def test_render_a_simulation_state_as_the_run_folder_frame(swirl, sph_scene, tmp_path):
+    """sim.render() draws the current state with the renderer swirl render uses: camera and colours fixed at the
+    first call, as from a run's first frame, so the same state gives the same picture as the run folder's frame."""
+    out = tmp_path / "dam_break"  # the caption names the run folder, or the scene file's stem: the same here
+    swirl.run(sph_scene, out, steps=20)
+    reference = swirl.render(out, 2, size=(320, 200))
+    sim = swirl.Simulation(sph_scene)
+    first = sim.render(size=(320, 200), png=tmp_path / "first.png")
+    np.testing.assert_array_equal(first, swirl.render(out, 0, size=(320, 200)))
+    assert (tmp_path / "first.png").stat().st_size > 1000
+    sim.step(20)
+    np.testing.assert_array_equal(sim.render(size=(320, 200)), reference)
+    # Other arguments fix the camera and colours anew; bad ones are refused.
+    assert sim.render(view="top", size=(128, 96)).shape == (96, 128, 3)
+    with pytest.raises(ValueError):
+        sim.render(view="sideways")
+    with pytest.raises(ValueError, match="at least 64"):
+        sim.render(size=(32, 32))

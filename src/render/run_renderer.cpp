@@ -148,14 +148,23 @@ RunInfo read_run(const std::filesystem::path& dir) {
   if (fs::exists(scene_file)) {
     // parse_scene on io's checked read: the scene loader's own read would block on a FIFO.
     const scene::Scene s = scene::parse_scene(io::read_regular_file(scene_file, io::kMaxSceneBytes), scene_file.string());
-    run.has_scene = true;
-    run.nbody = s.nbody.has_value();
-    if (s.walls && !run.nbody) run.box = s.box;
-    run.gravity = s.gravity;
-    if (s.sph) run.rest_density = s.sph->rest_density;
+    RunInfo from_scene = run_info_of(s);
+    from_scene.dir = run.dir;
+    from_scene.frames = std::move(run.frames);
+    run = std::move(from_scene);
   }
   run.scene_name = fs::absolute(dir).lexically_normal().filename().string();
   if (run.scene_name.empty()) run.scene_name = fs::absolute(dir).lexically_normal().parent_path().filename().string();
+  return run;
+}
+
+RunInfo run_info_of(const scene::Scene& s) {
+  RunInfo run;
+  run.has_scene = true;
+  run.nbody = s.nbody.has_value();
+  if (s.walls && !run.nbody) run.box = s.box;
+  run.gravity = s.gravity;
+  if (s.sph) run.rest_density = s.sph->rest_density;
   return run;
 }
 
@@ -163,7 +172,17 @@ std::filesystem::path png_path_for(const std::filesystem::path& out_dir, const s
   return out_dir / (frame_file.stem().string() + ".png");
 }
 
-RunRenderer::RunRenderer(RunInfo run, RenderOptions options) : run_(std::move(run)), options_(options) {
+namespace {
+Frame first_frame(const RunInfo& run) {
+  if (run.frames.empty()) throw io::IoError(run.dir.string() + ": no frames to render");
+  return load_frame(run.dir / run.frames.front().file);
+}
+}  // namespace
+
+RunRenderer::RunRenderer(RunInfo run, RenderOptions options) : RunRenderer(first_frame(run), run, options) {}
+
+RunRenderer::RunRenderer(const Frame& first, RunInfo run, RenderOptions options)
+    : run_(std::move(run)), options_(options) {
   if (options_.width < 64 || options_.height < 64 || options_.width > 16384 || options_.height > 16384)
     throw std::invalid_argument(fmt::format("picture size {}x{}: each side must be between 64 and 16384 pixels",
                                             options_.width, options_.height));
@@ -171,7 +190,6 @@ RunRenderer::RunRenderer(RunInfo run, RenderOptions options) : run_(std::move(ru
     throw std::invalid_argument("colour range: the upper end must be above the lower end");
   quantity_ = options_.color.value_or(run_.nbody ? Quantity::Density : Quantity::Speed);
   log_density_ = run_.nbody && quantity_ == Quantity::Density;
-  const Frame first = load_frame(run_.dir / run_.frames.front().file);
   if (first.positions.empty()) throw io::IoError(first.file.string() + ": the frame has no particles");
 
   const int bar_area = std::min(std::max(190, options_.width / 6), options_.width / 3);

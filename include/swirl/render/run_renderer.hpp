@@ -60,6 +60,10 @@ struct RunInfo {
 // cannot be read.
 RunInfo read_run(const std::filesystem::path& dir);
 
+// What a scene says for its pictures (read_run's part from scene.toml), for a
+// run that has no folder (a Simulation drawn from Python): no frames.
+RunInfo run_info_of(const scene::Scene& scene);
+
 // The PNG a frame is rendered to: out_dir / (the frame's stem + ".png").
 std::filesystem::path png_path_for(const std::filesystem::path& out_dir, const std::filesystem::path& frame_file);
 
@@ -67,6 +71,8 @@ class RunRenderer {
  public:
   // Loads the font and the run's first frame to fix the camera and colours.
   RunRenderer(RunInfo run, RenderOptions options);
+  // The same, the camera and colours fixed from `first` instead of a file.
+  RunRenderer(const Frame& first, RunInfo run, RenderOptions options);
 
   // The picture of one frame. Parallel inside (bit-identical for any thread
   // count), but not to be called from two threads at once (one Font).
