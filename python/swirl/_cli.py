@@ -84,20 +84,19 @@ def bench(suite, out=None, threads=None, quick=False, **options):
 
     Raises ValueError for options the suite refuses (status 2) and RuntimeError if it fails.
     """
-    words = ["bench", str(suite)]
-    if out is not None:
-        words += ["--out", str(out)]
+    # The folder is always passed, so that the results are read back from where they were written.
+    folder = pathlib.Path(out) if out is not None else pathlib.Path(
+        "out/bench-quick" if quick else "bench/results") / str(suite)
+    words = ["bench", str(suite), "--out", str(folder)]
     words += _flag_words("threads", list(threads) if threads is not None else None)
     words += _flag_words("quick", bool(quick))
     for name, value in options.items():
         words += _flag_words(name, value)
     status = cli(words)
     if status == 2:
-        raise ValueError(f"swirl bench {suite}: refused its arguments {words[2:]} (the message is on stderr)")
+        raise ValueError(f"swirl bench {suite}: refused its arguments {words[4:]} (the message is on stderr)")
     if status != 0:
         raise RuntimeError(f"swirl bench {suite}: failed with exit status {status} (the message is on stderr)")
-    folder = pathlib.Path(out) if out is not None else pathlib.Path(
-        "out/bench-quick" if quick else "bench/results") / str(suite)
     report = folder / f"{suite}.json"
     with open(report, encoding="utf-8") as f:
         return BenchResult(json.load(f), folder)

@@ -56,6 +56,16 @@ def test_bench_returns_the_suites_tables(swirl, tmp_path):
         swirl.bench("no-such-suite", out=tmp_path / "y")
 
 
+def test_bench_default_folder(swirl, tmp_path, monkeypatch):
+    """Without out=, the CLI's folders relative to the working directory (out/bench-quick/<suite> with quick)."""
+    import pathlib
+
+    monkeypatch.chdir(tmp_path)
+    result = swirl.bench("hash-stats", threads=[1], quick=True)
+    assert result.path == pathlib.Path("out/bench-quick/hash-stats")
+    assert (tmp_path / "out" / "bench-quick" / "hash-stats" / "hash-stats.json").exists()
+
+
 def test_bench_option_words(swirl, tmp_path):
     """Keywords become the CLI's flags: lists joined by commas, True a bare flag, None and False left out."""
     from swirl._cli import _flag_words
