@@ -5,19 +5,26 @@ nothing here re-implements a command.
 """
 
 import json
+import os
 import pathlib
+import subprocess
 import sys
+import tempfile
 
 from . import _swirl
 
 
-def cli(args):
+def cli(args, capture=False):
     """Runs the swirl command-line tool in this process, as ``swirl ARGS...`` in a shell.
 
     ``args`` is a list of strings without the program name: ``swirl.cli(["run", "scene.toml",
     "--out", "out/a"])``. Returns the tool's exit status (int): 0 done, 1 the run failed
     (blow-up, write error), 2 bad input; the tool prints its messages to this process's
     stdout and stderr (C stdio: in a notebook they go to the terminal that started it).
+    With ``capture=True`` they are captured instead and a ``subprocess.CompletedProcess``
+    is returned (``returncode``, ``stdout``, ``stderr`` as str): for notebooks. Capturing
+    redirects the process's file descriptors 1 and 2 for the call, so output of other
+    threads meanwhile is captured too.
 
     Ctrl-C during ``swirl run`` stops the run after its current step and writes a checkpoint,
     as in a shell; then KeyboardInterrupt is raised here. Python's own signal handlers and
@@ -31,11 +38,29 @@ def cli(args):
             raise TypeError(f"swirl.cli: every argument is a str or a path, got {type(w).__name__}: {w!r}")
     sys.stdout.flush()
     sys.stderr.flush()
-    status = _swirl.cli(words)
+    if capture:
+        with tempfile.TemporaryFile() as out, tempfile.TemporaryFile() as err:
+            saved = os.dup(1), os.dup(2)
+            try:
+                os.dup2(out.fileno(), 1)
+                os.dup2(err.fileno(), 2)
+                status = _swirl.cli(words)
+            finally:
+                os.dup2(saved[0], 1)
+                os.dup2(saved[1], 2)
+                os.close(saved[0])
+                os.close(saved[1])
+            out.seek(0)
+            err.seek(0)
+            captured = subprocess.CompletedProcess(["swirl", *words], status,
+                                                   out.read().decode(errors="replace"),
+                                                   err.read().decode(errors="replace"))
+    else:
+        status = _swirl.cli(words)
     if status in (130, 143):
         raise KeyboardInterrupt(f"swirl {' '.join(words[:1])}: stopped by a signal (exit status {status}); "
                                 "a run folder can be continued with swirl.resume()")
-    return status
+    return captured if capture else status
 
 
 def _flag_words(name, value):

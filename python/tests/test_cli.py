@@ -108,3 +108,15 @@ def test_cli_ctrl_c_checkpoints_and_raises(swirl, tmp_path):
     assert list((out / "checkpoints").glob("*.swc"))
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     assert swirl.cli(["run", "--resume", out, "--steps", "2"]) == 0
+
+
+def test_cli_capture_for_notebooks(swirl, tmp_path):
+    """capture=True: the tool's C stdio output comes back as strings, and the process's descriptors are restored."""
+    import os
+
+    before = [(os.fstat(fd).st_dev, os.fstat(fd).st_ino) for fd in (1, 2)]
+    result = swirl.cli(["--version"], capture=True)
+    assert result.returncode == 0 and result.stdout.startswith("swirl ") and result.stderr == ""
+    result = swirl.cli(["run", str(tmp_path / "missing.toml")], capture=True)
+    assert result.returncode == 2 and "missing.toml" in result.stderr and result.stdout == ""
+    assert [(os.fstat(fd).st_dev, os.fstat(fd).st_ino) for fd in (1, 2)] == before
