@@ -34,9 +34,7 @@ render::RenderOptions render_options(const std::string& view, const std::optiona
   options.view = render::parse_view(view);
   if (projection) options.projection = render::parse_projection(*projection);
   if (color) options.color = render::parse_quantity(*color);
-  if (width < 64 || height < 64)
-    throw nb::value_error(fmt::format("size {}x{}: each side must be at least 64 pixels", width, height).c_str());
-  options.width = width, options.height = height;
+  options.width = width, options.height = height;  // checked by RunRenderer (64 to 16384 pixels a side)
   options.range = range;
   return options;
 }

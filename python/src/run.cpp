@@ -80,13 +80,14 @@ struct PythonHooks {
   std::optional<nb::python_error> raised;
 
   bool any() const { return !forces.empty() || !callback.is_none(); }
-  // Calls fn(args...) unless something was raised already; an exception is
-  // kept (raised once the run returned) and stops the run after this step.
-  template <class... Args>
-  nb::object guarded(const nb::object& fn, Args&&... args) {
+  // Runs f() (Python calls, with the GIL held) unless something was raised
+  // already; an exception is kept (raised once the run returned) and stops the
+  // run after this step. Returns f's result, None if it raised or was skipped.
+  template <class F>
+  nb::object guarded(F&& f) {
     if (raised) return nb::none();
     try {
-      return fn(std::forward<Args>(args)...);
+      return std::forward<F>(f)();
     } catch (nb::python_error& e) {
       raised.emplace(std::move(e));
       *stop = true;
@@ -110,7 +111,7 @@ class PythonCallback final : public sim::Observer<Real> {
     if (!due) return;
     if (!hooks_.every_steps) schedule_.acted(sim.time());
     nb::gil_scoped_acquire gil;
-    nb::object r = hooks_.guarded(hooks_.callback);
+    nb::object r = hooks_.guarded([this] { return hooks_.callback(); });
     if (r.is(nb::bool_(false))) *hooks_.stop = true;
   }
   std::optional<double> next_time(const Simulation<Real>&) const override {
@@ -174,19 +175,20 @@ nb::dict run(const scene::Scene& scene, const std::string& out_dir, bool resume,
     options.extend_float = python_extension<float>(scene, hooks);
     options.extend_double = python_extension<double>(scene, hooks);
   }
-  const nb::object signals = nb::cpp_function([] { check_signals(); });
   auto on_progress = [&](const sim::RunProgress& p) {
     nb::gil_scoped_acquire gil;
-    hooks.guarded(signals);
-    if (!progress.is_none() && !hooks.raised) {
+    nb::object r = hooks.guarded([&]() -> nb::object {
+      check_signals();
+      if (progress.is_none()) return nb::none();
       nb::dict d;
       d["step"] = p.step;
       d["first_step"] = p.first_step;
       d["total_steps"] = p.total_steps;
       d["time"] = p.sim_time;
       d["wall_seconds"] = p.wall_seconds;
-      if (hooks.guarded(progress, d).is(nb::bool_(false))) stop = true;
-    }
+      return progress(d);
+    });
+    if (r.is(nb::bool_(false))) stop = true;
   };
   sim::RunSummary summary;
   try {

@@ -106,5 +106,7 @@ def test_render_a_simulation_state_as_the_run_folder_frame(swirl, sph_scene, tmp
     assert sim.render(view="top", size=(128, 96)).shape == (96, 128, 3)
     with pytest.raises(ValueError):
         sim.render(view="sideways")
-    with pytest.raises(ValueError, match="at least 64"):
+    with pytest.raises(ValueError, match="between 64 and 16384"):
         sim.render(size=(32, 32))
+    with pytest.raises(ValueError, match="between 64 and 16384"):
+        swirl.render(out, 0, size=(100000, 100))

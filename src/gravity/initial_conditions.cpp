@@ -115,20 +115,11 @@ void add_hernquist(Sample& s, std::size_t n, SplitMix64& rng, double mass_cut) {
   }
 }
 
-// The centre of mass of particles [begin, end).
-V3 centre_of_mass(const Sample& s, std::size_t begin, std::size_t end) {
-  double mass = 0;
-  V3 mx{};
-  for (std::size_t i = begin; i < end; ++i) {
-    mass += s.m[i];
-    for (std::size_t a = 0; a < 3; ++a) mx[a] += s.m[i] * s.x[i][a];
-  }
-  for (double& c : mx) c /= mass;
-  return mx;
-}
-
-// Shifts particles [begin, end) so that their centre of mass is at x0 moving with v0.
-void recentre(Sample& s, std::size_t begin, std::size_t end, const V3& x0, const V3& v0) {
+// The centre of mass of particles [begin, end) and its velocity.
+struct Centre {
+  V3 position{}, velocity{};
+};
+Centre centre_of_mass(const Sample& s, std::size_t begin, std::size_t end) {
   double mass = 0;
   V3 mx{}, mv{};
   for (std::size_t i = begin; i < end; ++i) {
@@ -138,10 +129,18 @@ void recentre(Sample& s, std::size_t begin, std::size_t end, const V3& x0, const
       mv[a] += s.m[i] * s.v[i][a];
     }
   }
+  Centre c;
+  for (std::size_t a = 0; a < 3; ++a) c.position[a] = mx[a] / mass, c.velocity[a] = mv[a] / mass;
+  return c;
+}
+
+// Shifts particles [begin, end) so that their centre of mass is at x0 moving with v0.
+void recentre(Sample& s, std::size_t begin, std::size_t end, const V3& x0, const V3& v0) {
+  const Centre c = centre_of_mass(s, begin, end);
   for (std::size_t i = begin; i < end; ++i)
     for (std::size_t a = 0; a < 3; ++a) {
-      s.x[i][a] += x0[a] - mx[a] / mass;
-      s.v[i][a] += v0[a] - mv[a] / mass;
+      s.x[i][a] += x0[a] - c.position[a];
+      s.v[i][a] += v0[a] - c.velocity[a];
     }
 }
 
@@ -191,8 +190,9 @@ ParticleSet<Real> hernquist(std::size_t n, std::uint64_t seed, const HernquistOp
   // Only the velocity of the centre of mass is removed: the ρ ∝ r⁻⁴ tail moves the
   // sample's centre of mass by about √(2 a r_max / 3N) from the cusp (0.05 a at
   // N = 65 536), and the cusp, not that point, is the halo's centre.
-  const V3 x0 = centre_of_mass(s, 0, n);
-  recentre(s, 0, n, x0, {});
+  const V3 drift = centre_of_mass(s, 0, n).velocity;
+  for (V3& v : s.v)
+    for (std::size_t k = 0; k < 3; ++k) v[k] -= drift[k];
   return to_particles<Real>(s);
 }
 

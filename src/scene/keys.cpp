@@ -601,15 +601,19 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
                               .required = true},
                     in_source(&StellarSource::count)));
   k.push_back(seed_key<StellarSource>("seeds the model"));
-  const auto plummer_cut = [](auto& src) { auto* m = std::get_if<StellarSource>(&src); return m ? &m->plummer.mass_cut : nullptr; };
-  const auto collision = [](auto member) {
-    return [member](auto& src) { auto* m = std::get_if<StellarSource>(&src); return m ? &(m->collision.*member) : nullptr; };
+  // A field of one model's options (StellarSource::plummer, ::collision, ::hernquist).
+  const auto in_options = [](auto options, auto member) {
+    return [options, member](auto& src) {
+      auto* m = std::get_if<StellarSource>(&src);
+      return m ? &((m->*options).*member) : nullptr;
+    };
   };
+  const auto collision = [&](auto member) { return in_options(&StellarSource::collision, member); };
   switch (model) {
     case Model::Plummer:
       k.push_back(field(SourceKey{.key = "mass_cut", .range = kFraction,
                                   .doc = "the fraction of the infinite model's mass kept (its outskirts cut)"},
-                        plummer_cut));
+                        in_options(&StellarSource::plummer, &gravity::PlummerOptions::mass_cut)));
       break;
     case Model::UniformSphere:
     case Model::UniformCube:
@@ -643,9 +647,7 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
                         collision(&gravity::CollisionOptions::mass_cut)));
       break;
     case Model::Hernquist: {
-      const auto halo = [](auto member) {
-        return [member](auto& src) { auto* m = std::get_if<StellarSource>(&src); return m ? &(m->hernquist.*member) : nullptr; };
-      };
+      const auto halo = [&](auto member) { return in_options(&StellarSource::hernquist, member); };
       k.push_back(field(SourceKey{.key = "scale_radius", .unit = "length", .range = kPositive,
                                   .doc = "a: the density falls as r⁻¹ inside it and r⁻⁴ outside; 1/3 gives E = −1/4 "
                                          "(Hénon units) for the whole model",
