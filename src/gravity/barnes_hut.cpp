@@ -59,21 +59,22 @@ BarnesHut<Real>::BarnesHut(const GravitySettings& settings) : settings_(settings
 }
 
 template <class Real>
-void BarnesHut<Real>::compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size) {
-  compute_impl(p, out, block_size);
+void BarnesHut<Real>::compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+                              const ActiveSet& active) {
+  compute_impl(p, out, block_size, active);
 }
 
 template <class Real>
 void BarnesHut<Real>::compute_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
                                      const std::array<double, 3>& corner, double side, GravityField<Real>& out,
-                                     std::size_t block_size) {
+                                     std::size_t block_size, const ActiveSet& active) {
   if (!uses_linear_tree()) throw std::logic_error("BarnesHut::compute_sorted: only the linear tree is a view of an order");
   if (block_size == 0) throw std::invalid_argument("gravity: block size must be at least 1");
   out.resize(p.size());
   stats_ = GravityStats{};
   const auto t0 = Clock::now();
   linear_.build_sorted(p, sorted_keys, corner, side, linear_settings(), block_size);
-  evaluate_linear(p.size(), out, block_size, seconds_since(t0));
+  evaluate_linear(p.size(), out, block_size, seconds_since(t0), active);
 }
 
 template <class Real>
@@ -91,18 +92,24 @@ LinearTreeSettings BarnesHut<Real>::linear_settings() const {
 }
 
 template <class Real>
-void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size) {
+void BarnesHut<Real>::compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+                                     const ActiveSet& active) {
   const auto t0 = Clock::now();
   linear_.build(p, linear_settings(), block_size);
-  evaluate_linear(p.size(), out, block_size, seconds_since(t0));
+  evaluate_linear(p.size(), out, block_size, seconds_since(t0), active);
 }
 
 template <class Real>
 void BarnesHut<Real>::evaluate_linear(std::size_t n, GravityField<Real>& out, std::size_t block_size,
-                                      double build_seconds) {
+                                      double build_seconds, const ActiveSet& active) {
   stats_.tree_build_seconds = build_seconds;
   const auto t1 = Clock::now();
-  const WalkCounts counts = linear_.evaluate(out, block_size);
+  const WalkCounts counts = linear_.evaluate(out, block_size, active);
+  if (!active.all()) {
+    n = 0;
+    for (std::size_t i = 0; i < out.size(); ++i) n += active.contains(i);
+  }
+  stats_.walked = n;
   stats_.force_seconds = seconds_since(t1);
   stats_.trees = 1;
   stats_.nodes = linear_.nodes().size();
@@ -116,13 +123,14 @@ void BarnesHut<Real>::evaluate_linear(std::size_t n, GravityField<Real>& out, st
 
 template <class Real>
 void BarnesHut<Real>::compute_impl(const ParticleSet<Real>& p, GravityField<Real>& out,
-                                   std::size_t block_size) {
+                                   std::size_t block_size, const ActiveSet& active) {
   if (block_size == 0) throw std::invalid_argument("gravity: block size must be at least 1");
   if (p.size() >= Octree<Real>::npos) throw std::invalid_argument("gravity: too many particles for 32-bit tree indices");
   const std::size_t n = p.size();
   out.resize(n);
   stats_ = GravityStats{};
-  if (uses_linear_tree()) return compute_linear(p, out, block_size);
+  stats_.walked = n;
+  if (uses_linear_tree()) return compute_linear(p, out, block_size, active);
 
   const auto t0 = Clock::now();
   weights_.clear();

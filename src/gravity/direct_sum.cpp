@@ -31,7 +31,8 @@ void sum_range(const Real* px, const Real* py, const Real* pz, const Real* m, st
 }  // namespace
 
 template <class Real>
-void direct_sum(const ParticleSet<Real>& p, Real softening, std::size_t block_size, GravityField<Real>& out) {
+void direct_sum(const ParticleSet<Real>& p, Real softening, std::size_t block_size, GravityField<Real>& out,
+                const ActiveSet& active) {
   if (!(softening >= 0 && std::isfinite(softening)))
     throw std::invalid_argument("direct_sum: softening epsilon must be finite and >= 0");
   const std::size_t n = p.size();
@@ -40,6 +41,7 @@ void direct_sum(const ParticleSet<Real>& p, Real softening, std::size_t block_si
   const Real *px = p.position.x.data(), *py = p.position.y.data(), *pz = p.position.z.data(), *m = p.mass.data();
   parallel::for_blocks("gravity_direct_sum", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     for (std::size_t i = b; i < e; ++i) {
+      if (!active.contains(i)) continue;
       // a_i = Σ_{j≠i} m_j (x_j − x_i) / (|r|² + ε²)^{3/2}, φ_i = −Σ_{j≠i} m_j / sqrt(|r|² + ε²)
       Accumulator<Real> acc;
       sum_range(px, py, pz, m, 0, i, px[i], py[i], pz[i], eps2, acc);
@@ -52,7 +54,9 @@ void direct_sum(const ParticleSet<Real>& p, Real softening, std::size_t block_si
   });
 }
 
-template void direct_sum<float>(const ParticleSet<float>&, float, std::size_t, GravityField<float>&);
-template void direct_sum<double>(const ParticleSet<double>&, double, std::size_t, GravityField<double>&);
+template void direct_sum<float>(const ParticleSet<float>&, float, std::size_t, GravityField<float>&,
+                                const ActiveSet&);
+template void direct_sum<double>(const ParticleSet<double>&, double, std::size_t, GravityField<double>&,
+                                 const ActiveSet&);
 
 }  // namespace swirl::gravity

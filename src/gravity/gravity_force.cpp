@@ -43,18 +43,19 @@ template <class Real>
 void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
   if (settings_.method == Method::Direct) {
     const auto t0 = std::chrono::steady_clock::now();
-    direct_sum(p, Real(settings_.softening), ctx.block_size, field_);
+    direct_sum(p, Real(settings_.softening), ctx.block_size, field_, ctx.active);
     stats_ = GravityStats{};
     stats_.mean_nodes_visited = p.empty() ? 0.0 : double(p.size() - 1);
+    for (std::size_t i = 0; i < p.size(); ++i) stats_.walked += ctx.active.contains(i);
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   } else {
     const auto* order = ctx.order;
     if (views_order() && order && order->valid() && order->frame().curve == spatial::CellOrder::Morton &&
         order->keys().size() == p.size()) {
       const auto& f = order->frame();
-      tree_.compute_sorted(p, order->keys(), f.corner, f.root_side(), field_, ctx.block_size);
+      tree_.compute_sorted(p, order->keys(), f.corner, f.root_side(), field_, ctx.block_size, ctx.active);
     } else {
-      tree_.compute(p, field_, ctx.block_size);
+      tree_.compute(p, field_, ctx.block_size, ctx.active);
     }
     stats_ = tree_.stats();
   }
@@ -62,7 +63,16 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
   Real* phi = p.extra(phi_field).data();
   const Real G = Real(options_.G);
   const bool unit = options_.G == 1;
+  const ActiveSet& active = ctx.active;
   parallel::for_blocks("gravity_add", p.size(), ctx.block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    if (!active.all()) {  // block time steps: only the active particles' entries are this evaluation's
+      for (std::size_t i = b; i < e; ++i) {
+        if (!active.contains(i)) continue;
+        for (int a = 0; a < 3; ++a) p.acceleration[a][i] += unit ? field_.acceleration[a][i] : G * field_.acceleration[a][i];
+        phi[i] = unit ? field_.potential[i] : G * field_.potential[i];
+      }
+      return;
+    }
     for (int a = 0; a < 3; ++a) {
       Real* acc = p.acceleration[a].data();
       const Real* add = field_.acceleration[a].data();
@@ -82,6 +92,7 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
   }
   nodes_sum_ += stats_.mean_nodes_visited;
   ++evaluations_;
+  particle_evaluations_ += double(stats_.walked);
   particles_ = p.size();
 }
 
@@ -120,6 +131,7 @@ double GravityForce<Real>::potential_energy(const ParticleSet<Real>& p, std::siz
 template <class Real>
 void GravityForce<Real>::add_metrics(NamedValues& out) const {
   out.emplace_back("mean_nodes_visited", evaluations_ > 0 ? nodes_sum_ / double(evaluations_) : stats_.mean_nodes_visited);
+  out.emplace_back("particle_force_evaluations", particle_evaluations_);
   if (stats_.tree_bytes > 0 && particles_ > 0)
     out.emplace_back("tree_bytes_per_particle", double(stats_.tree_bytes) / double(particles_));
 }
@@ -128,12 +140,14 @@ template <class Real>
 void GravityForce<Real>::save_state(NamedValues& out) const {
   out.emplace_back("self_gravity.nodes_sum", nodes_sum_);
   out.emplace_back("self_gravity.evaluations", double(evaluations_));
+  out.emplace_back("self_gravity.particle_evaluations", particle_evaluations_);
 }
 
 template <class Real>
 void GravityForce<Real>::load_state(const NamedValues& values) {
   nodes_sum_ = find_value(values, "self_gravity.nodes_sum").value_or(0.0);
   evaluations_ = static_cast<std::uint64_t>(find_value(values, "self_gravity.evaluations").value_or(0.0));
+  particle_evaluations_ = find_value(values, "self_gravity.particle_evaluations").value_or(0.0);
 }
 
 template class GravityForce<float>;

@@ -438,8 +438,14 @@ std::uint64_t LinearOctree<Real>::walk_group(std::size_t g, GroupLists& lists) c
   const LinearNodes<Real>& t = nodes_;
   const std::uint32_t group = groups_[g];
   const std::uint32_t gb = t.begin[group], ge = t.end[group];
-  Real lo[3] = {x_[gb], y_[gb], z_[gb]}, hi[3] = {x_[gb], y_[gb], z_[gb]};
-  for (std::uint32_t s = gb + 1; s < ge; ++s) {
+  GroupLists& l = lists;
+  // The targets: every particle of the group, or its active ones.
+  l.targets.clear();
+  for (std::uint32_t s = gb; s < ge; ++s)
+    if (active_slot_.empty() || active_slot_[s]) l.targets.push_back(s);
+  const std::uint32_t first = l.targets.front();
+  Real lo[3] = {x_[first], y_[first], z_[first]}, hi[3] = {x_[first], y_[first], z_[first]};
+  for (const std::uint32_t s : l.targets) {
     lo[0] = std::min(lo[0], x_[s]);
     lo[1] = std::min(lo[1], y_[s]);
     lo[2] = std::min(lo[2], z_[s]);
@@ -447,7 +453,6 @@ std::uint64_t LinearOctree<Real>::walk_group(std::size_t g, GroupLists& lists) c
     hi[1] = std::max(hi[1], y_[s]);
     hi[2] = std::max(hi[2], z_[s]);
   }
-  GroupLists& l = lists;
   for (auto* a : {&l.px, &l.py, &l.pz, &l.pm, &l.cx, &l.cy, &l.cz, &l.cm, &l.cqxx, &l.cqxy, &l.cqxz, &l.cqyy, &l.cqyz})
     a->clear();
   auto add_particles = [&](std::uint32_t b, std::uint32_t e) {
@@ -456,7 +461,15 @@ std::uint64_t LinearOctree<Real>::walk_group(std::size_t g, GroupLists& lists) c
     l.pz.insert(l.pz.end(), z_.begin() + b, z_.begin() + e);
     l.pm.insert(l.pm.end(), m_.begin() + b, m_.begin() + e);
   };
-  add_particles(gb, ge);  // the group's own particles first: self_offset = 0 skips the self pairs
+  // The group's own particles first, the targets in their order (self_offset
+  // = 0 skips the self pairs), then a partly active group's other particles.
+  if (l.targets.size() == std::size_t(ge - gb)) {
+    add_particles(gb, ge);
+  } else {
+    for (const std::uint32_t s : l.targets) add_particles(s, s + 1);
+    for (std::uint32_t s = gb; s < ge; ++s)
+      if (!active_slot_[s]) add_particles(s, s + 1);
+  }
   l.stack.resize(kStackDepth);
   std::uint32_t* stack = l.stack.data();
   std::size_t top = 0;
@@ -509,14 +522,26 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
   // an estimate, the curve moving little between steps — or, the first time,
   // the particle count. The order changes only who computes a group, never
   // its result.
+  // With an active set: only the groups holding an active particle, each
+  // costed by its active slots.
+  const bool partial = !active_slot_.empty();
   std::vector<double> cost(groups);
   const bool known = slot_cost_.size() == n;
+  schedule_.clear();
   for (std::size_t g = 0; g < groups; ++g) {
     const std::uint32_t b = t.begin[groups_[g]], e = t.end[groups_[g]];
-    cost[g] = known ? std::accumulate(slot_cost_.begin() + b, slot_cost_.begin() + e, 0.0) : double(e - b);
+    double c = 0;
+    std::size_t active = e - b;
+    if (partial) {
+      active = 0;
+      for (std::uint32_t s = b; s < e; ++s)
+        if (active_slot_[s]) ++active, c += known ? slot_cost_[s] : 1.0;
+    } else {
+      c = known ? std::accumulate(slot_cost_.begin() + b, slot_cost_.begin() + e, 0.0) : double(e - b);
+    }
+    cost[g] = c;
+    if (active > 0) schedule_.push_back(std::uint32_t(g));
   }
-  schedule_.resize(groups);
-  std::iota(schedule_.begin(), schedule_.end(), 0u);
   std::sort(schedule_.begin(), schedule_.end(),
             [&](std::uint32_t a, std::uint32_t b) { return cost[a] > cost[b] || (cost[a] == cost[b] && a < b); });
 
@@ -525,17 +550,23 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
   const Real eps2 = Real(settings_.softening * settings_.softening);
   const bool quadrupole = settings_.multipole == Multipole::Quadrupole;
   const KernelPath path = settings_.simd_kernels ? KernelPath::Simd : KernelPath::Scalar;
-  parallel::for_blocks("linear_octree_group_walk", groups, 1, [&](std::size_t k, std::size_t, std::size_t) {
+  parallel::for_blocks("linear_octree_group_walk", schedule_.size(), 1, [&](std::size_t k, std::size_t, std::size_t) {
     const std::size_t g = schedule_[k];
     const auto thread = std::size_t(parallel::thread_index());
     if (thread >= lists_.size()) throw std::logic_error("linear octree: more threads than list buffers");
     GroupLists& l = lists_[thread];
     const std::uint64_t popped = walk_group(g, l);
     const std::uint32_t first = t.begin[groups_[g]];
-    const std::size_t count = t.end[groups_[g]] - first;
+    const std::size_t count = l.targets.size();
+    const Real *tx = x_.data() + first, *ty = y_.data() + first, *tz = z_.data() + first;
+    if (count < std::size_t(t.end[groups_[g]] - first)) {  // partly active: the targets' own copies
+      l.tx.resize(count), l.ty.resize(count), l.tz.resize(count);
+      for (std::size_t k2 = 0; k2 < count; ++k2)
+        l.tx[k2] = x_[l.targets[k2]], l.ty[k2] = y_[l.targets[k2]], l.tz[k2] = z_[l.targets[k2]];
+      tx = l.tx.data(), ty = l.ty.data(), tz = l.tz.data();
+    }
     for (auto* a : {&l.ax, &l.ay, &l.az, &l.phi}) a->assign(count, Real(0));
-    const Targets<Real> targets{x_.data() + first, y_.data() + first, z_.data() + first, l.ax.data(),
-                                l.ay.data(),       l.az.data(),       l.phi.data(),      count};
+    const Targets<Real> targets{tx, ty, tz, l.ax.data(), l.ay.data(), l.az.data(), l.phi.data(), count};
     SourceParticles<Real> particles{l.px.data(), l.py.data(), l.pz.data(), l.pm.data(), l.px.size()};
     particles.self_offset = 0;
     add_particle_field(particles, targets, eps2, path);
@@ -545,7 +576,7 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
       add_cell_field(cells, targets, eps2, quadrupole, path);
     }
     for (std::size_t k2 = 0; k2 < count; ++k2) {
-      const std::uint32_t i = order_[first + k2];
+      const std::uint32_t i = order_[l.targets[k2]];
       out.acceleration.x[i] = l.ax[k2];
       out.acceleration.y[i] = l.ay[k2];
       out.acceleration.z[i] = l.az[k2];
@@ -556,13 +587,16 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
   });
 
   WalkCounts total;
+  for (const WalkCounts& c : group_counts_) {
+    total.nodes += c.nodes;
+    total.multipoles += c.multipoles;
+    total.pairs += c.pairs;
+  }
+  if (partial) return total;  // the costs per slot are those of full evaluations
   slot_cost_.resize(n);
   const double cell_flops = quadrupole ? kQuadrupoleFlops : kMonopoleFlops;
   for (std::size_t g = 0; g < groups; ++g) {
     const WalkCounts& c = group_counts_[g];
-    total.nodes += c.nodes;
-    total.multipoles += c.multipoles;
-    total.pairs += c.pairs;
     // In flops of the kernels, plus a guess of ~20 per node visited.
     const std::uint32_t b = t.begin[groups_[g]], e = t.end[groups_[g]];
     const double group_cost = double(c.pairs) * kParticleFlops + double(c.multipoles) * cell_flops + 20.0 * double(c.nodes);
@@ -572,8 +606,16 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
 }
 
 template <class Real>
-WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size) {
-  out.resize(x_.size());
+WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size, const ActiveSet& active) {
+  const std::size_t n = x_.size();
+  out.resize(n);
+  active_slot_.clear();
+  if (!active.all()) {
+    active_slot_.resize(n);
+    parallel::for_blocks("linear_octree_active", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t s = b; s < e; ++s) active_slot_[s] = active.contains(order_[s]) ? 1 : 0;
+    });
+  }
   if (settings_.walk == Walk::Group) return evaluate_groups(out);
   return evaluate_particles(out, block_size);
 }
@@ -587,6 +629,7 @@ WalkCounts LinearOctree<Real>::evaluate_particles(GravityField<Real>& out, std::
       [&](std::size_t b, std::size_t e) {
         WalkCounts counts;
         for (std::size_t s = b; s < e; ++s) {
+          if (!active_slot_.empty() && !active_slot_[s]) continue;
           Accumulator<Real> acc;
           walk_one(s, acc, counts);
           const std::uint32_t i = order_[s];

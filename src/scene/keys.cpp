@@ -28,6 +28,7 @@ namespace {
 // The name tables, found by the enum's type.
 constexpr std::span<const EnumName<Precision>> names_of(Precision) { return kPrecisionNames; }
 constexpr std::span<const EnumName<Units>> names_of(Units) { return kUnitsNames; }
+constexpr std::span<const EnumName<TimeSteps>> names_of(TimeSteps) { return kTimeStepsNames; }
 constexpr std::span<const EnumName<OutputFormat>> names_of(OutputFormat) { return kOutputFormatNames; }
 constexpr std::span<const EnumName<sph::PressureForm>> names_of(sph::PressureForm) { return sph::kPressureFormNames; }
 constexpr std::span<const EnumName<sph::NegativePressure>> names_of(sph::NegativePressure) {
@@ -288,6 +289,16 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "simulation.eta", .section = "simulation", .range = Range{0, 10, true, false},
                      .doc = "η, gravity Δt ≤ η·sqrt(ε / \\|a\\|max) (ε = 0: the mean particle spacing in place of ε)"},
             in_scene(&Scene::eta)));
+  add(field(SceneKey{.key = "simulation.time_steps", .section = "simulation", .noun = "time-step scheme",
+                     .doc = "`\"global\"`: one step for every particle; `\"block\"` (needs `[nbody]` with a softening "
+                            "> 0, a fixed `dt`, no walls): each particle in its own bin dt/2^k by η·sqrt(ε/\\|a_i\\|), "
+                            "forces only for the particles whose steps end ([gravity.md](gravity.md))",
+                     .unhashed_value = "global"},
+            in_scene(&Scene::time_steps)));
+  add(field(SceneKey{.key = "simulation.max_bin", .section = "simulation", .range = Range{0, 40},
+                     .doc = "only with `time_steps = \"block\"`: the finest bin, dt/2^max_bin; a particle that needs a "
+                            "finer one is a blow-up"},
+            [](auto& s) { return s.time_steps == TimeSteps::Block ? &s.max_bin : nullptr; }));
   add(field(SceneKey{.key = "simulation.max_energy_error", .section = "simulation", .range = kNonNegative,
                      .doc = "a run whose forces and walls all conserve energy stops (a blow-up) when its relative "
                             "energy error \\|E − E0\\|/\\|E0\\| at an output time exceeds this (0 = never)",

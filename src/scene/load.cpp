@@ -321,6 +321,8 @@ void read_simulation(const Table& t, Scene& s) {
   if (!s.adaptive_dt) s.dt = t.number(spec_of("simulation.dt"), "dt");
   for (const std::string_view k : {"dt_max", "dt_min"})
     if (!s.adaptive_dt && t.find(k)) t.fail(k, fmt::format("needs {} = \"adaptive\" (a fixed dt is the step itself)", t.key("dt")));
+  if (s.time_steps != TimeSteps::Block && t.find("max_bin"))
+    t.fail("max_bin", fmt::format("only with {} = \"block\"", t.key("time_steps")));
   const bool has_end_time = t.find("end_time") != nullptr;
   const bool has_steps = t.find("steps") != nullptr;
   if (has_end_time && has_steps)

@@ -39,6 +39,16 @@ class Checker {
                                               *s_.end_time / s_.dt, s_.dt));
     if (s_.adaptive_dt && !(s_.dt_min < s_.dt))
       fail("simulation.dt_min", fmt::format("must be smaller than simulation.dt_max = {}, got {}", s_.dt, s_.dt_min));
+    if (s_.time_steps == TimeSteps::Block) {
+      // The bins are powers of two below one fixed step, by the gravity condition per particle.
+      if (s_.adaptive_dt)
+        fail("simulation.time_steps", "\"block\" needs a fixed simulation.dt (the largest step, bin 0), not \"adaptive\"");
+      if (!s_.nbody || !(s_.nbody->softening > 0))
+        fail("simulation.time_steps",
+             "\"block\" needs [nbody] with nbody.softening > 0: a particle's bin comes from eta*sqrt(softening/|a|)");
+      if (s_.walls)
+        fail("simulation.time_steps", "\"block\" needs open space (no [box]): the walls reflect on whole steps");
+    }
   }
 
   // G is a key only with [nbody] (keys() checked it there), but a Scene built

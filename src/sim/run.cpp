@@ -670,6 +670,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   summary.phases = sim.timers().phases();
   summary.frames = frames->frames();
   for (const auto& s : sim.solvers()) s->add_metrics(summary.metrics);
+  sim.stepper().add_metrics(summary.metrics);
   if (const auto error = diagnostics->energy_error()) summary.metrics.emplace_back("relative_energy_error", *error);
   if (sim.order().active()) summary.metrics.emplace_back("sorts", double(sim.order().sorts()));
   if (adaptive && progress->dt_max() > 0) {  // landing steps included

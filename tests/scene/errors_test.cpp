@@ -309,5 +309,31 @@ TEST(SceneErrors, NoCrashOnAnyInput) {
   survives(std::string("\0\xff\xfe[box]", 8));
 }
 
+// Block time steps: a fixed largest step, gravity with a softening, open space.
+TEST(SceneErrors, BlockTimeStepsNeedAFixedStepGravityAndOpenSpace) {
+  const std::string open_nbody =
+      minimal("[box]\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\n", "[nbody]\nsoftening = 0.01\n");
+  const std::string block = edit(open_nbody, "dt = 0.01", "dt = 0.01\ntime_steps = \"block\"");
+  EXPECT_NO_THROW((void)parse_scene(block, "scene.toml"));
+  for (const Case& c : std::vector<Case>{
+           {"adaptive", edit(block, "dt = 0.01", "dt = \"adaptive\"\ndt_max = 0.01"),
+            "simulation.time_steps: \"block\" needs a fixed simulation.dt (the largest step, bin 0), not \"adaptive\""},
+           {"no softening", edit(block, "softening = 0.01", "softening = 0"),
+            "simulation.time_steps: \"block\" needs [nbody] with nbody.softening > 0: a particle's bin comes from "
+            "eta*sqrt(softening/|a|)"},
+           {"no gravity", edit(block, "[nbody]\nsoftening = 0.01\n", ""),
+            "simulation.time_steps: \"block\" needs [nbody] with nbody.softening > 0: a particle's bin comes from "
+            "eta*sqrt(softening/|a|)"},
+           {"walls", edit(block, "[nbody]", "[box]\nmin = [-1, -1, -1]\nmax = [1, 1, 1]\n\n[nbody]"),
+            "simulation.time_steps: \"block\" needs open space (no [box]): the walls reflect on whole steps"},
+           {"max_bin range", edit(block, "time_steps = \"block\"", "time_steps = \"block\"\nmax_bin = 41"),
+            "simulation.max_bin: must be in [0, 40], got 41"},
+           {"max_bin without block", edit(open_nbody, "dt = 0.01", "dt = 0.01\nmax_bin = 4"),
+            "simulation.max_bin: only with simulation.time_steps = \"block\""},
+       }) {
+    expect_error(c);
+  }
+}
+
 }  // namespace
 }  // namespace swirl::scene

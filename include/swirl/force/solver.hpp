@@ -15,7 +15,9 @@
 //    needs particles sorted by space asks for it with order_request() and
 //    reads the order's keys from the context). It runs its loops through
 //    parallel::for_blocks with ctx.block_size and gives bit-identical results
-//    for any thread count; it throws with a message a user can act on;
+//    for any thread count; it throws with a message a user can act on. With
+//    an active set in the context (block time steps) it must compute the
+//    active particles and may skip the others (core/active_set.hpp);
 //  - its time-step conditions: scan_needs() says what the step's scan must
 //    measure; add_limits() turns the scan into StepLimits; explain() words a
 //    limit for the blow-up guard, and advice() says what to change when the
@@ -32,6 +34,7 @@
 #include <string_view>
 #include <vector>
 
+#include "swirl/core/active_set.hpp"
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/phase_timers.hpp"
@@ -47,6 +50,7 @@ struct SolverContext {
   std::size_t block_size = 1;                           // work-block size for parallel passes
   PhaseTimers* timers = nullptr;                        // where a solver may time its sub-phases
   const spatial::ParticleOrder<Real>* order = nullptr;  // the particle order, current for these positions
+  ActiveSet active;  // the particles to compute (block time steps); others' acceleration may be left as is
 };
 
 // A limit's words for the guard: the rule with its numbers, and the change that relaxes it.
@@ -116,7 +120,7 @@ void evaluate_alone(Solver<Real>& solver, ParticleSet<Real>& particles, spatial:
   solver.declare_fields(particles);
   order.set_request(solver.order_request());
   order.update(particles, block_size);
-  solver.add_acceleration(particles, SolverContext<Real>{time, block_size, timers, order.active() ? &order : nullptr});
+  solver.add_acceleration(particles, SolverContext<Real>{time, block_size, timers, order.active() ? &order : nullptr, {}});
 }
 
 // The same with an order made for this one call (no skin carried over).

@@ -63,7 +63,8 @@ namespace swirl::gravity {
 
 // What the last evaluation did.
 struct GravityStats {
-  double mean_nodes_visited = 0;  // nodes taken from visit lists per particle, over all trees it walked
+  double mean_nodes_visited = 0;  // nodes taken from visit lists per particle walked, over all trees it walked
+  std::size_t walked = 0;         // particles whose field was computed (the active ones, or all)
   std::size_t trees = 0;          // sub-domain trees, sub-tree units, or 1 (global); 0 for the direct sum
   std::size_t nodes = 0;          // nodes built (sum over trees)
   int depth = 0;                  // deepest tree level
@@ -83,13 +84,16 @@ class BarnesHut {
 
   // Overwrites out (resized to p.size()) with the tree field of p. block_size
   // is the block of the per-particle passes (results do not depend on it).
-  void compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  // With an active set the linear tree computes only its particles
+  // (linear_octree.hpp); the paper's tree and schemes compute every particle.
+  void compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+               const ActiveSet& active = {});
   // The linear tree as a view of particles already sorted along the Morton
   // curve (the simulation's order: sorted_keys[i] is particle i's 63-bit key
   // in the cube of side `side` at `corner`): no sort, no copy. Linear tree only.
   void compute_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
                       const std::array<double, 3>& corner, double side, GravityField<Real>& out,
-                      std::size_t block_size);
+                      std::size_t block_size, const ActiveSet& active = {});
 
   // True when compute() walks the linear octree (scheme global, tree linear).
   bool uses_linear_tree() const { return settings_.scheme == Scheme::Global && settings_.tree == Tree::Linear; }
@@ -129,10 +133,13 @@ class BarnesHut {
   };
   class RunPacker;
 
-  void compute_impl(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
-  void compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  void compute_impl(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+                    const ActiveSet& active);
+  void compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+                      const ActiveSet& active);
   LinearTreeSettings linear_settings() const;
-  void evaluate_linear(std::size_t n, GravityField<Real>& out, std::size_t block_size, double build_seconds);
+  void evaluate_linear(std::size_t n, GravityField<Real>& out, std::size_t block_size, double build_seconds,
+                       const ActiveSet& active);
   void build_subdomains(const ParticleSet<Real>& p);
   void split_adaptive();
   void split_paper_cells();

@@ -62,6 +62,17 @@
 //             carry over a rebuild as an estimate); each group's result
 //             depends only on the tree, never on the thread or the order.
 //
+// Active sets (core/active_set.hpp, block time steps): only the active
+// particles are computed. The particle walk skips the others (each active
+// particle's result is the full evaluation's, bit for bit). The group walk
+// skips groups without an active particle; in a partly active group the box
+// of the opening test is the active particles' (tighter: fewer nodes opened)
+// and only they are targets, the group's own sources listed actives first:
+// the same terms as the full evaluation, summed in another order and
+// possibly with fewer nodes opened, so equal to it within the opening
+// criterion's error and round-off, not bitwise. A fully active group is
+// computed exactly as in the full evaluation.
+//
 // Units: G = 1; lengths as the positions; side of the root cube = root_side().
 #pragma once
 
@@ -72,6 +83,7 @@
 #include <span>
 #include <vector>
 
+#include "swirl/core/active_set.hpp"
 #include "swirl/core/aligned.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/gravity/field.hpp"
@@ -141,9 +153,10 @@ class LinearOctree {
   void adopt_curve_order();
 
   // Writes out[order()[s]] for every particle (out resized to the particle
-  // count), with settings().walk. Not const: the group walk keeps its
+  // count), with settings().walk; with an active set (indexed like the
+  // ParticleSet), for its particles only. Not const: the group walk keeps its
   // per-thread lists and the groups' costs for the next call.
-  WalkCounts evaluate(GravityField<Real>& out, std::size_t block_size);
+  WalkCounts evaluate(GravityField<Real>& out, std::size_t block_size, const ActiveSet& active = {});
 
   // The group walk's groups (node indices, in curve order), and the order the
   // last group walk handed them to the threads (indices into groups()).
@@ -179,12 +192,15 @@ class LinearOctree {
     AlignedVector<Real> px, py, pz, pm;                                   // particle sources
     AlignedVector<Real> cx, cy, cz, cm, cqxx, cqxy, cqxz, cqyy, cqyz;      // cell sources
     AlignedVector<Real> ax, ay, az, phi;                                  // the group's field
+    AlignedVector<Real> tx, ty, tz;                                       // a partly active group's targets
+    std::vector<std::uint32_t> targets;                                   // the targets' sorted slots
     std::vector<std::uint32_t> stack;
   };
   void make_groups();
   WalkCounts evaluate_particles(GravityField<Real>& out, std::size_t block_size) const;
   WalkCounts evaluate_groups(GravityField<Real>& out);
-  // Fills lists for group g; returns the nodes popped.
+  // Fills lists for group g (its active particles' list when active_slot_ is
+  // set: lists.targets); returns the nodes popped.
   std::uint64_t walk_group(std::size_t g, GroupLists& lists) const;
 
   LinearTreeSettings settings_;
@@ -204,6 +220,7 @@ class LinearOctree {
   std::vector<double> slot_cost_;        // per sorted slot: its group's last cost / its size
   std::vector<WalkCounts> group_counts_;
   std::vector<GroupLists> lists_;        // per thread
+  std::vector<std::uint8_t> active_slot_;  // this evaluation's active flags per sorted slot (empty: all)
 };
 
 extern template class LinearOctree<float>;

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <string_view>
 
 #include "swirl/core/named_values.hpp"
@@ -26,11 +27,21 @@
 
 namespace swirl::integrate {
 
+// The integer field of individual time steps: each particle's bin
+// (core/active_set.hpp). Declared by a stepper that uses evaluate_active().
+inline constexpr std::string_view kTimeBinField = "time_bin";
+
 // The force evaluation a stepper calls: a ← F(x) at the given time.
 class Forces {
  public:
   virtual ~Forces() = default;
   virtual void evaluate(double time) = 0;
+  // The same for the particles whose kTimeBinField is >= min_bin; the others'
+  // acceleration is left unspecified (solvers may compute it or not).
+  virtual void evaluate_active(double time, std::int32_t min_bin) {
+    (void)min_bin;
+    evaluate(time);
+  }
 };
 
 // One step to take.
@@ -58,6 +69,11 @@ struct Escape {
 struct StepOutcome {
   StepScan scan;  // of the new state
   Escape escape;
+  // A stepper that divides the step (individual time steps): the finest sub-step
+  // the next step will use for its particles, checked by the guard against
+  // the solvers' limits in place of the whole step; 0: the step is not divided.
+  double finest_dt = 0;
+  std::string finest_fix;  // what relaxes it, for the guard's message (e.g. "a larger max_bin")
 };
 
 template <class Real>
@@ -72,6 +88,8 @@ class Stepper {
   virtual void start(ParticleSet<Real>& particles, Forces& forces, double time, std::size_t block_size) = 0;
   // Advances by request.dt.
   virtual StepOutcome advance(ParticleSet<Real>& particles, Forces& forces, const StepRequest& request) = 0;
+  // Summary figures over the run so far (e.g. sub-steps taken).
+  virtual void add_metrics(NamedValues& /*out*/) const {}
   // State across a checkpoint beyond the particle fields (names prefixed with name() + ".").
   virtual void save_state(NamedValues& /*out*/) const {}
   virtual void load_state(const NamedValues& /*values*/) {}

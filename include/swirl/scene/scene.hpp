@@ -33,11 +33,16 @@ enum class OutputFormat { Vtp, Csv, Hdf5 };
 // The unit system of a scene's numbers: SI (m, s, kg; G = 6.67430e-11
 // m³ kg⁻¹ s⁻²) or N-body units (G = 1, Hénon units for the stellar models).
 enum class Units { SI, NBody };
+// simulation.time_steps: one step for every particle, or individual
+// power-of-two bins below it (integrate/block_steps.hpp).
+enum class TimeSteps { Global, Block };
 
 inline constexpr std::array<EnumName<Precision>, 2> kPrecisionNames{{{"float", Precision::Float}, {"double", Precision::Double}}};
 inline constexpr std::array<EnumName<OutputFormat>, 3> kOutputFormatNames{
     {{"vtp", OutputFormat::Vtp}, {"csv", OutputFormat::Csv}, {"hdf5", OutputFormat::Hdf5}}};
 inline constexpr std::array<EnumName<Units>, 2> kUnitsNames{{{"si", Units::SI}, {"nbody", Units::NBody}}};
+inline constexpr std::array<EnumName<TimeSteps>, 2> kTimeStepsNames{
+    {{"global", TimeSteps::Global}, {"block", TimeSteps::Block}}};
 
 // The gravitational constant in SI units, m³ kg⁻¹ s⁻² (CODATA 2018).
 inline constexpr double kGravitationalConstantSI = 6.67430e-11;
@@ -128,6 +133,10 @@ struct Scene {
   double force_factor = 0.4;               // simulation.force_factor: C_force, SPH Δt ≤ C_force·sqrt(h/|a|max)
   double viscous_factor = 0.125;           // simulation.viscous_factor: C_visc, SPH Δt ≤ C_visc·h²·ρ/μ
   double eta = 0.75;                       // simulation.eta: η, gravity Δt ≤ η·sqrt(ε/|a|max)
+  // simulation.time_steps = "block": dt is the largest step, each particle
+  // steps in its own bin dt/2^k, k ≤ simulation.max_bin, by η·sqrt(ε/|a_i|).
+  TimeSteps time_steps = TimeSteps::Global;
+  std::uint32_t max_bin = 20;              // simulation.max_bin, in [0, 40]
   // simulation.max_energy_error: a run whose forces and walls all conserve energy
   // stops (a blow-up) when |E − E0|/|E0| at an output time exceeds this; 0 = never.
   double max_energy_error = 0.1;

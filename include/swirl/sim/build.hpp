@@ -1,5 +1,6 @@
 // Building the Simulation a scene describes: its particles, its stepper (with
-// the box's walls, or open space) and its solvers, each made from its own
+// the box's walls, or open space; block time steps with simulation.time_steps)
+// and its solvers, each made from its own
 // section of the scene — SPH from [sph], self-gravity from [nbody] (G from
 // simulation.units / nbody.G), a uniform field from forces.gravity, a drag
 // from forces.damping. Nothing above this file knows which solvers a run has:
@@ -12,6 +13,7 @@
 #include "swirl/force/damping.hpp"
 #include "swirl/force/uniform_gravity.hpp"
 #include "swirl/gravity/gravity_force.hpp"
+#include "swirl/integrate/block_steps.hpp"
 #include "swirl/integrate/kick_drift.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/scene.hpp"
@@ -31,7 +33,12 @@ Simulation<Real> build_simulation(const scene::Scene& scene) {
   if (scene.walls && scene.sph) settings.escape_length = scene.sph->smoothing_length;
   std::optional<boundary::BoxCollision<Real>> box;
   if (scene.walls) box = boundary::BoxCollision<Real>{scene.box.template cast<Real>(), Real(scene.restitution)};
-  auto stepper = std::make_unique<integrate::KickDriftStepper<Real>>(integrate::Method::VelocityVerlet, std::move(box));
+  std::unique_ptr<integrate::Stepper<Real>> stepper;
+  if (scene.time_steps == scene::TimeSteps::Block)
+    stepper = std::make_unique<integrate::BlockStepper<Real>>(
+        integrate::BlockStepOptions{scene.eta, scene.nbody->softening, int(scene.max_bin)});
+  else
+    stepper = std::make_unique<integrate::KickDriftStepper<Real>>(integrate::Method::VelocityVerlet, std::move(box));
   Simulation<Real> sim(scene::make_particles<Real>(scene), settings, std::move(stepper));
   if (scene.sph)
     sim.add_solver(std::make_unique<sph::SphFluid<Real>>(

@@ -208,7 +208,12 @@ class Simulation {
     if (!checks) return;
     if (outcome.escape.found) report(BlowUpCause::LeftDomain, escape_message(outcome.escape));
     const StepLimit& tight = tightest();
-    if (!settings_.adaptive && settings_.dt > tight.dt) report(BlowUpCause::TimeStep, condition_message(tight));
+    if (outcome.finest_dt > 0) {  // divided steps: the finest sub-step against the tightest limit
+      if (outcome.finest_dt > tight.dt * (1 + 1e-12))
+        report(BlowUpCause::TimeStep, condition_message(tight, outcome.finest_dt, outcome.finest_fix));
+    } else if (!settings_.adaptive && settings_.dt > tight.dt) {
+      report(BlowUpCause::TimeStep, condition_message(tight, settings_.dt, "or dt = \"adaptive\""));
+    }
   }
 
   // The step the next step() takes before any landing: the fixed Δt, or the
@@ -272,7 +277,8 @@ class Simulation {
   class Evaluation final : public integrate::Forces {
    public:
     explicit Evaluation(Simulation& sim) : sim_(sim) {}
-    void evaluate(double t) override { sim_.compute_forces(t); }
+    void evaluate(double t) override { sim_.compute_forces(t, 0); }
+    void evaluate_active(double t, std::int32_t min_bin) override { sim_.compute_forces(t, min_bin); }
 
    private:
     Simulation& sim_;
@@ -280,7 +286,9 @@ class Simulation {
 
   double time_of(std::uint64_t step) const { return static_cast<double>(step) * settings_.dt; }
 
-  void compute_forces(double t) {
+  // a ← F(x) at time t, for every particle or (min_bin > 0) for those whose
+  // time bin is at least min_bin (the field is found after the order's sort).
+  void compute_forces(double t, std::int32_t min_bin) {
     ScopedPhase phase(timers_, "forces");
     parallel::for_blocks_pinned("zero_acceleration", particles_.size(), settings_.block_size,
                                 [&](std::size_t b, std::size_t e, std::size_t) {
@@ -301,7 +309,12 @@ class Simulation {
         throw_non_finite(first_non_finite_position());
       }
     }
-    const SolverContext<Real> ctx{t, settings_.block_size, &timers_, order_.active() ? &order_ : nullptr};
+    SolverContext<Real> ctx{t, settings_.block_size, &timers_, order_.active() ? &order_ : nullptr, {}};
+    if (min_bin > 0) {
+      const std::size_t bins = particles_.find_int_field(integrate::kTimeBinField);
+      if (bins == ParticleSet<Real>::npos) throw std::logic_error("Simulation: an active evaluation without time bins");
+      ctx.active = ActiveSet{particles_.int_field(bins).data(), min_bin};
+    }
     for (auto& s : solvers_) s->add_acceleration(particles_, ctx);
   }
 
@@ -395,10 +408,10 @@ class Simulation {
         fix_for_dt(suggested_dt()));
   }
 
-  std::string condition_message(const StepLimit& l) const {
+  std::string condition_message(const StepLimit& l, double dt, std::string_view alternative) const {
     const LimitText text = solvers_.at(l.source)->explain(l, particle_id(l.particle));
-    return fmt::format("{}: blow-up: time step too large: dt = {:.6g} exceeds {}; fix: dt <= {:.6g}, or dt = \"adaptive\"{}{}",
-                       where(), settings_.dt, text.rule, l.dt, text.fix.empty() ? "" : ", ", text.fix);
+    return fmt::format("{}: blow-up: time step too large: dt = {:.6g} exceeds {}; fix: dt <= {:.6g}, {}{}{}", where(), dt,
+                       text.rule, l.dt, alternative, text.fix.empty() ? "" : ", ", text.fix);
   }
 
   [[noreturn]] void throw_collapse(double proposal) const {
