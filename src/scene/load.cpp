@@ -506,15 +506,18 @@ void read_snapshot_file(const Table& t, SnapshotSource& src) {
       type = static_cast<int>(*src.part_type);
     } else {
       // The default is the only type with particles; several are a choice the scene must make.
+      // (None: read_snapshot's rule for an empty file, and validate() refuses the empty source.)
       const auto counts = io::snapshot_particle_counts(path);
       std::string groups, types;
+      int present = 0;
       for (int k = 0; k < io::kGadgetTypes; ++k) {
         if (counts[static_cast<std::size_t>(k)] == 0) continue;
         groups += fmt::format("{}/PartType{} ({})", groups.empty() ? "" : ", ", k, counts[static_cast<std::size_t>(k)]);
         types += fmt::format("{}{}", types.empty() ? "" : " or ", k);
-        type = type ? -1 : k;
+        type = k;
+        ++present;
       }
-      if (type && *type < 0)
+      if (present > 1)
         t.fail("part_type", fmt::format("missing, and {} has particles in {}: give part_type = {} (one [[particles]] "
                                         "source per type)",
                                         src.file, groups, types));
