@@ -386,6 +386,13 @@ Opened open_snapshot(const fs::path& path, std::optional<int> part_type) {
   else if (!out.info.si_units)
     out.info.gravitational_constant = 1;
   if (!std::isfinite(out.info.time)) r.fail("/Header/Time", "is not finite");
+  // One file of a split snapshot holds only some of the particles: read alone it would silently lose the rest.
+  if (const auto files = r.attribute<std::int64_t>(header, "/Header", "NumFilesPerSnapshot", H5T_NATIVE_INT64, 1);
+      files && (*files)[0] > 1)
+    r.fail("/Header/NumFilesPerSnapshot",
+           fmt::format("is {}: this file is one part of a snapshot split over several files, which swirl does not "
+                       "read (join the parts into one file first)",
+                       (*files)[0]));
   if (r.has(root, "Units")) {
     // What the file's units are, for a reader that must not take them for its own (scene sources).
     Id units(H5Gopen2(root, "Units", H5P_DEFAULT), H5Gclose);

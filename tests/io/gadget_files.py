@@ -38,7 +38,7 @@ def write(kind, path):
             h.attrs["Time"] = 0.5
             h.attrs["Redshift"] = 0.0
             h.attrs["BoxSize"] = 0.0
-            h.attrs["NumFilesPerSnapshot"] = 1
+            h.attrs["NumFilesPerSnapshot"] = 2 if kind == "split" else 1
             if kind == "future":
                 h.attrs["SwirlFormatVersion"] = 99
             if kind == "nbody_units":

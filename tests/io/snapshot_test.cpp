@@ -204,6 +204,7 @@ TEST(Snapshot, BadFilesAreRefusedNamingTheDataset) {
            {"no_mass", "/PartType1/Masses: missing, and /Header/MassTable gives no mass"},
            {"string_coordinates", "/PartType1/Coordinates: is not numeric"},
            {"future", "/Header/SwirlFormatVersion: is 99, newer than this swirl's"},
+           {"split", "/Header/NumFilesPerSnapshot: is 2: this file is one part of a snapshot split"},
        }) {
     SCOPED_TRACE(kind);
     gadget_file(dir.path(), kind);

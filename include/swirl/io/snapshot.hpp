@@ -30,7 +30,8 @@
 // Reading accepts any file with that layout (masses either per particle or
 // from MassTable) and refuses anything else with an IoError naming the file
 // and the group, dataset or attribute, and the reason: missing, wrong shape or
-// type, a count that disagrees with the header, a value that is not finite.
+// type, a count that disagrees with the header, a value that is not finite,
+// one part of a snapshot split over several files (NumFilesPerSnapshot > 1).
 // One particle type is read at a time: the one asked for (any of Gadget's six,
 // as initial-condition files split a galaxy into halo, disk and bulge types),
 // or else the only type 0 or 1 the file has particles of.
