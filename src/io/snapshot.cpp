@@ -24,7 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kTypes = 6;                    // Gadget's particle types
+constexpr int kTypes = kGadgetTypes;         // Gadget's particle types
 constexpr hsize_t kChunkRows = 1 << 16;      // rows per chunk
 constexpr unsigned kDeflateLevel = 1;
 
@@ -315,70 +315,125 @@ template SnapshotLayout write_snapshot<double>(const fs::path&, const ParticleSe
 
 namespace {
 
-// A snapshot opened and its header checked: what both readers start from.
-struct Opened {
+// A snapshot file opened, its header's particle counts read.
+struct Head {
   Reader r;
-  SnapshotFile head;  // info, version, count
-  std::optional<std::vector<double>> mass_table;
-  std::string where;  // "/PartType<k>"
-  Id group;
-  std::vector<std::string> datasets;  // the group's datasets, by name
+  Id header;
+  std::array<std::uint64_t, kTypes> counts{};
 };
 
-Opened open_snapshot(const fs::path& path) {
+Head open_head(const fs::path& path) {
   silence_hdf5();
   std::error_code ec;
   if (!fs::is_regular_file(path, ec)) throw IoError(fmt::format("{}: not a regular file", path.string()));
   if (fs::file_size(path, ec) > max_particle_file_bytes())
     throw IoError(fmt::format("{}: larger than the {} bytes a particle file may have", path.string(),
                               max_particle_file_bytes()));
-  Opened o{Reader{path, {}}, {}, std::nullopt, {}, {}, {}};
-  Reader& r = o.r;
+  Head h{Reader{path, {}}, {}, {}};
+  Reader& r = h.r;
   if (H5Fis_hdf5(path.string().c_str()) <= 0) throw IoError(fmt::format("{}: not an HDF5 file", path.string()));
   r.file = Id(H5Fopen(path.string().c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   if (!r.file.valid()) throw IoError(fmt::format("{}: cannot be opened as HDF5", path.string()));
-  const hid_t root = r.file.get();
-
-  if (!r.has(root, "Header")) r.fail("/Header", "missing (not a Gadget-format snapshot)");
-  Id header(H5Gopen2(root, "Header", H5P_DEFAULT), H5Gclose);
-  if (!header.valid()) r.fail("/Header", "is not a group");
-  const auto counts = r.attribute<std::uint64_t>(header.get(), "/Header", "NumPart_ThisFile", H5T_NATIVE_UINT64, kTypes);
+  if (!r.has(r.file.get(), "Header")) r.fail("/Header", "missing (not a Gadget-format snapshot)");
+  h.header = Id(H5Gopen2(r.file.get(), "Header", H5P_DEFAULT), H5Gclose);
+  if (!h.header.valid()) r.fail("/Header", "is not a group");
+  const auto counts = r.attribute<std::uint64_t>(h.header.get(), "/Header", "NumPart_ThisFile", H5T_NATIVE_UINT64, kTypes);
   if (!counts) r.fail("/Header/NumPart_ThisFile", "missing");
-  o.mass_table = r.attribute<double>(header.get(), "/Header", "MassTable", H5T_NATIVE_DOUBLE, kTypes);
+  std::copy(counts->begin(), counts->end(), h.counts.begin());
+  return h;
+}
+
+// "/PartType0, /PartType1": the particle groups a file has, for messages.
+std::string part_groups(const Reader& r) {
+  std::string out;
+  for (int k = 0; k < kTypes; ++k)
+    if (r.has(r.file.get(), fmt::format("PartType{}", k).c_str()))
+      out += fmt::format("{}/PartType{}", out.empty() ? "" : ", ", k);
+  return out.empty() ? std::string("no /PartType<k> group") : out;
+}
+
+// A snapshot opened and its header checked: what both readers start from.
+struct Opened {
+  Reader r;
+  SnapshotFile head;  // info, version, count, units
+  std::optional<std::vector<double>> mass_table;
+  std::string where;  // "/PartType<k>"
+  Id group;
+  std::vector<std::string> datasets;  // the group's datasets, by name
+};
+
+Opened open_snapshot(const fs::path& path, std::optional<int> part_type) {
+  Head h = open_head(path);
+  Opened o{std::move(h.r), {}, std::nullopt, {}, {}, {}};
+  Reader& r = o.r;
+  const hid_t root = r.file.get();
+  const hid_t header = h.header.get();
+  const auto& counts = h.counts;
+  o.mass_table = r.attribute<double>(header, "/Header", "MassTable", H5T_NATIVE_DOUBLE, kTypes);
   SnapshotFile& out = o.head;
-  if (const auto t = r.attribute<double>(header.get(), "/Header", "Time", H5T_NATIVE_DOUBLE, 1)) out.info.time = (*t)[0];
-  if (const auto b = r.attribute<double>(header.get(), "/Header", "BoxSize", H5T_NATIVE_DOUBLE, 1))
+  if (const auto t = r.attribute<double>(header, "/Header", "Time", H5T_NATIVE_DOUBLE, 1)) out.info.time = (*t)[0];
+  if (const auto b = r.attribute<double>(header, "/Header", "BoxSize", H5T_NATIVE_DOUBLE, 1))
     out.info.box_size = (*b)[0];
-  if (const auto v = r.attribute<int>(header.get(), "/Header", "SwirlFormatVersion", H5T_NATIVE_INT, 1))
+  if (const auto v = r.attribute<int>(header, "/Header", "SwirlFormatVersion", H5T_NATIVE_INT, 1))
     out.version = (*v)[0];
   if (out.version > kSnapshotVersion)
     r.fail("/Header/SwirlFormatVersion",
            fmt::format("is {}, newer than this swirl's {}: read it with a newer swirl", out.version, kSnapshotVersion));
-  out.info.si_units = r.text(header.get(), "UnitSystem") != "nbody";
-  if (const auto g = r.attribute<double>(header.get(), "/Header", "GravitationalConstant", H5T_NATIVE_DOUBLE, 1))
+  out.unit_system = r.text(header, "UnitSystem");
+  out.info.si_units = out.unit_system != "nbody";
+  if (const auto g = r.attribute<double>(header, "/Header", "GravitationalConstant", H5T_NATIVE_DOUBLE, 1))
     out.info.gravitational_constant = (*g)[0];
   else if (!out.info.si_units)
     out.info.gravitational_constant = 1;
   if (!std::isfinite(out.info.time)) r.fail("/Header/Time", "is not finite");
+  // One file of a split snapshot holds only some of the particles: read alone it would silently lose the rest.
+  if (const auto files = r.attribute<std::int64_t>(header, "/Header", "NumFilesPerSnapshot", H5T_NATIVE_INT64, 1);
+      files && (*files)[0] > 1)
+    r.fail("/Header/NumFilesPerSnapshot",
+           fmt::format("is {}: this file is one part of a snapshot split over several files, which swirl does not "
+                       "read (join the parts into one file first)",
+                       (*files)[0]));
+  if (r.has(root, "Units")) {
+    // What the file's units are, for a reader that must not take them for its own (scene sources).
+    Id units(H5Gopen2(root, "Units", H5P_DEFAULT), H5Gclose);
+    if (!units.valid()) r.fail("/Units", "is not a group");
+    const auto factor = [&](const char* name) {
+      const auto v = r.attribute<double>(units.get(), "/Units", name, H5T_NATIVE_DOUBLE, 1);
+      if (!v) r.fail(fmt::format("/Units/{}", name), "missing");
+      if (!((*v)[0] > 0) || !std::isfinite((*v)[0]))
+        r.fail(fmt::format("/Units/{}", name), fmt::format("must be a finite number > 0, got {}", (*v)[0]));
+      return (*v)[0];
+    };
+    out.cgs_units = CgsUnits{factor("Unit length in cgs (U_L)"), factor("Unit mass in cgs (U_M)"),
+                             factor("Unit time in cgs (U_t)")};
+  }
 
   int type = -1;
-  for (int k = 0; k < kTypes; ++k) {
-    if ((*counts)[std::size_t(k)] == 0) continue;
-    if (type >= 0)
-      r.fail("/Header/NumPart_ThisFile",
-             fmt::format("has particles of types {} and {}: swirl reads one particle type per file", type, k));
-    type = k;
+  if (part_type) {
+    if (*part_type < 0 || *part_type >= kTypes)
+      throw IoError(fmt::format("{}: particle type {} is not one of Gadget's 0 to {}", path.string(), *part_type,
+                                kTypes - 1));
+    type = *part_type;
+  } else {
+    for (int k = 0; k < kTypes; ++k) {
+      if (counts[std::size_t(k)] == 0) continue;
+      if (type >= 0)
+        r.fail("/Header/NumPart_ThisFile",
+               fmt::format("has particles of types {} and {}: swirl reads one particle type per file", type, k));
+      type = k;
+    }
+    if (type < 0) type = r.has(root, "PartType1") ? 1 : 0;  // an empty snapshot
+    if (type > 1)
+      r.fail("/Header/NumPart_ThisFile", fmt::format("has particles of type {}: swirl reads types 0 and 1", type));
   }
-  if (type < 0) type = r.has(root, "PartType1") ? 1 : 0;  // an empty snapshot
-  if (type > 1) r.fail("/Header/NumPart_ThisFile", fmt::format("has particles of type {}: swirl reads types 0 and 1", type));
   out.info.type = PartType(type);
-  const std::uint64_t count = (*counts)[std::size_t(type)];
+  const std::uint64_t count = counts[std::size_t(type)];
   if (count > max_particle_file_bytes() / 24)
     r.fail("/Header/NumPart_ThisFile", fmt::format("says {} particles, more than the file can hold", count));
   out.count = std::size_t(count);
 
   o.where = fmt::format("/PartType{}", type);
-  if (!r.has(root, o.where.c_str() + 1)) r.fail(o.where, "missing");
+  if (!r.has(root, o.where.c_str() + 1)) r.fail(o.where, fmt::format("missing (the file has {})", part_groups(r)));
   o.group = Id(H5Gopen2(root, o.where.c_str() + 1, H5P_DEFAULT), H5Gclose);
   if (!o.group.valid()) r.fail(o.where, "is not a group");
   std::vector<std::string> names;  // H5Literate visits the links in name order
@@ -398,8 +453,12 @@ Opened open_snapshot(const fs::path& path) {
 
 }  // namespace
 
-SnapshotFile read_snapshot(const fs::path& path) {
-  Opened o = open_snapshot(path);
+std::array<std::uint64_t, kGadgetTypes> snapshot_particle_counts(const fs::path& path) {
+  return open_head(path).counts;
+}
+
+SnapshotFile read_snapshot(const fs::path& path, std::optional<int> part_type) {
+  Opened o = open_snapshot(path, part_type);
   const Reader& r = o.r;
   SnapshotFile out = std::move(o.head);
   const std::string& where = o.where;
@@ -448,7 +507,7 @@ SnapshotFile read_snapshot(const fs::path& path) {
 }
 
 SnapshotLayout read_snapshot_layout(const fs::path& path) {
-  Opened o = open_snapshot(path);
+  Opened o = open_snapshot(path, std::nullopt);
   SnapshotLayout layout;
   layout.time = o.head.info.time;
   layout.type = o.head.info.type;

@@ -100,6 +100,7 @@ constexpr KeyType key_type() {
   else if constexpr (std::is_same_v<T, Vec3d>) return KeyType::Vector;
   else if constexpr (std::is_same_v<T, std::vector<Vec3d>>) return KeyType::VectorList;
   else if constexpr (std::is_same_v<T, std::vector<double>>) return KeyType::NumberList;
+  else if constexpr (std::is_same_v<T, std::string>) return KeyType::Text;
   else return KeyType::NameList;  // std::vector of a named enum
 }
 
@@ -126,6 +127,8 @@ std::optional<KeyValue> to_value(const T& v) {
     std::vector<std::string_view> names;
     for (const auto item : v) names.push_back(enum_name(names_of(item), item));
     return KeyValue{std::move(names)};
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return KeyValue{std::string_view(v)};  // a view into the owner's string
   } else {
     return KeyValue{v};
   }
@@ -150,6 +153,8 @@ void from_value(const KeyValue& v, T& out) {
   } else if constexpr (EnumList<T>) {
     out.clear();
     for (const auto name : std::get<std::vector<std::string_view>>(v)) out.push_back(enum_of<typename T::value_type>(name));
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    out = std::string(std::get<std::string_view>(v));
   } else {
     out = std::get<T>(v);
   }
@@ -677,6 +682,24 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
   return k;
 }
 
+std::vector<SourceKey> snapshot_keys() {
+  std::vector<SourceKey> k;
+  k.push_back(field(SourceKey{.key = "file",
+                              .doc = "a Gadget-format HDF5 file (written by h5py, another code or swirl), relative to the scene file's "
+                                     "folder; saved with a run as the absolute path it resolved to",
+                              .required = true, .type_doc = "string (a path)"},
+                    in_source(&SnapshotSource::file)));
+  k.push_back(field(SourceKey{.key = "part_type", .range = Range{0, 5, false, false},
+                              .doc = "which `/PartType<k>` group to read (one source per type)",
+                              .default_doc = "the only type with particles"},
+                    in_source(&SnapshotSource::part_type)));
+  k.push_back(field(SourceKey{.key = "offset", .unit = "length", .doc = "moves every particle"},
+                    in_source(&SnapshotSource::offset)));
+  k.push_back(field(SourceKey{.key = "velocity", .unit = "length/time", .doc = "added to every particle's velocity"},
+                    in_source(&SnapshotSource::velocity)));
+  return k;
+}
+
 std::vector<SourceKind> declare_source_kinds() {
   std::vector<SourceKind> kinds;
   kinds.push_back({"lattice", "particles on a cubic lattice filling a region", lattice_keys(false), LatticeSource{}});
@@ -691,6 +714,10 @@ std::vector<SourceKind> declare_source_kinds() {
     prototype.model = model.value;
     kinds.push_back({model.name, "a self-gravitating model (open space only)", stellar_keys(model.value), prototype});
   }
+  kinds.push_back({"snapshot",
+                   "particles read from a Gadget-format HDF5 file: a swirl `hdf5` frame, or initial conditions from "
+                   "another code",
+                   snapshot_keys(), SnapshotSource{}});
   // Each key's docs table is its kind.
   for (auto& kind : kinds)
     for (auto& key : kind.keys) key.section = kind.name;
@@ -719,6 +746,7 @@ std::string_view type_text(KeyType type) {
     case KeyType::Vector: return "vector";
     case KeyType::VectorList: return "array of vectors";
     case KeyType::NumberList: return "array of numbers";
+    case KeyType::Text: return "string";
   }
   return "?";
 }
@@ -805,6 +833,33 @@ const SourceKind& kind_of(const ParticleSource& source) {
   return *it;
 }
 
+namespace {
+
+// `text` as a TOML basic string: `"` and `\` escaped, and every control
+// character, so that any path reads back as itself.
+std::string toml_string(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    switch (c) {
+      case '"': out += "\\\""; break;
+      case '\\': out += "\\\\"; break;
+      case '\b': out += "\\b"; break;
+      case '\t': out += "\\t"; break;
+      case '\n': out += "\\n"; break;
+      case '\f': out += "\\f"; break;
+      case '\r': out += "\\r"; break;
+      default:
+        if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+          out += fmt::format("\\u{:04X}", static_cast<unsigned>(static_cast<unsigned char>(c)));
+        else
+          out += c;
+    }
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
 std::string value_text(const KeyValue& value, bool exact) {
   const auto number = [exact](double v) { return exact ? fmt::format("{:.17g}", v) : fmt::format("{}", v); };
   const auto vec = [&](const Vec3d& v) { return fmt::format("[{}, {}, {}]", number(v.x), number(v.y), number(v.z)); };
@@ -813,13 +868,13 @@ std::string value_text(const KeyValue& value, bool exact) {
         if constexpr (std::is_same_v<T, double>) return number(v);
         else if constexpr (std::is_same_v<T, std::uint64_t>) return fmt::format("{}", v);
         else if constexpr (std::is_same_v<T, bool>) return v ? "true" : "false";
-        else if constexpr (std::is_same_v<T, std::string_view>) return fmt::format("\"{}\"", v);
+        else if constexpr (std::is_same_v<T, std::string_view>) return toml_string(v);
         else if constexpr (std::is_same_v<T, Vec3d>) return vec(v);
         else {
           std::string out = "[";
           for (std::size_t i = 0; i < v.size(); ++i) {
             out += i ? ", " : "";
-            if constexpr (std::is_same_v<T, std::vector<std::string_view>>) out += fmt::format("\"{}\"", v[i]);
+            if constexpr (std::is_same_v<T, std::vector<std::string_view>>) out += toml_string(v[i]);
             else if constexpr (std::is_same_v<T, std::vector<Vec3d>>) out += vec(v[i]);
             else out += number(v[i]);
           }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <iterator>
 #include <limits>
 #include <memory>
@@ -21,6 +22,7 @@
 #include "messages.hpp"
 #include "sources.hpp"
 #include "swirl/io/read_file.hpp"
+#include "swirl/io/snapshot.hpp"
 #include "swirl/scene/keys.hpp"
 #include "swirl/scene/validate.hpp"
 #include "swirl/sph/lattice_mass.hpp"
@@ -222,6 +224,13 @@ class Reader {
         return names;
       }
       case KeyType::Vector: return vec3(node, where);
+      case KeyType::Text: {
+        const auto* s = node.as_string();
+        if (!s) wrong_type(where, "a string", node);
+        const std::string_view text = s->get();  // the node outlives the set() that copies it
+        detail::check_value(spec, KeyValue{text}, file_, where);
+        return text;
+      }
       case KeyType::VectorList:
       case KeyType::NumberList: break;  // read by hand (ListSource), with messages of their own
     }
@@ -466,6 +475,77 @@ void read_list(const Table& t, ListSource& src) {
   }
 }
 
+// A snapshot source's file: its path resolved and its particles read.
+//
+// The path is relative to the scene file's folder (to the working directory
+// for a scene without one: "<dict>", "<toml>"), and is resolved here, once, to
+// an absolute, lexically normal path, which parse_scene writes back into the
+// scene's TOML: the copy saved with a run then names the same file from any
+// working directory (`swirl run --resume OUT` reads OUT/scene.toml), and the
+// scene hash sees the same path in the first run and in the resume.
+//
+// The file is read whole, now: its refusals (a missing file or group, a
+// wrong shape, a NaN) come when the scene is loaded, as every other scene
+// error does, before a run folder exists; the count is exact for validation
+// and the memory estimate; and the particles validated are the ones built.
+// A resume reads it again (the scene is rebuilt before the checkpoint
+// replaces its particles), so the message for a missing file says so.
+void read_snapshot_file(const Table& t, SnapshotSource& src) {
+  namespace fs = std::filesystem;
+  const fs::path base = fs::path(std::string(t.reader().file())).parent_path();
+  std::error_code ec;
+  const fs::path path = fs::absolute(base / fs::path(src.file), ec).lexically_normal();
+  if (ec) t.fail("file", fmt::format("'{}' cannot be made absolute: {}", src.file, ec.message()));
+  src.file = path.string();
+  if (!fs::exists(path, ec))
+    t.fail("file", fmt::format("{}: no such file (the scene reads it whenever it is loaded, `swirl run --resume` "
+                               "included, which rebuilds the scene before the checkpoint replaces its particles: put "
+                               "the file back at this path)",
+                               src.file));
+  try {
+    std::optional<int> type;
+    if (src.part_type) {
+      type = static_cast<int>(*src.part_type);
+    } else {
+      // The default is the only type with particles; several are a choice the scene must make.
+      // (None: read_snapshot's rule for an empty file, and validate() refuses the empty source.)
+      const auto counts = io::snapshot_particle_counts(path);
+      std::string groups, types;
+      int present = 0;
+      for (int k = 0; k < io::kGadgetTypes; ++k) {
+        if (counts[static_cast<std::size_t>(k)] == 0) continue;
+        groups += fmt::format("{}/PartType{} ({})", groups.empty() ? "" : ", ", k, counts[static_cast<std::size_t>(k)]);
+        types += fmt::format("{}{}", types.empty() ? "" : " or ", k);
+        type = k;
+        ++present;
+      }
+      if (present > 1)
+        t.fail("part_type", fmt::format("missing, and {} has particles in {}: give part_type = {} (one [[particles]] "
+                                        "source per type)",
+                                        src.file, groups, types));
+    }
+    io::SnapshotFile file = io::read_snapshot(path, type);
+    auto content = std::make_shared<SnapshotContent>();
+    content->group = fmt::format("/PartType{}", static_cast<int>(file.info.type));
+    const auto rows = [&](const char* name) -> const std::vector<double>& { return file.datasets.at(name).values; };
+    const auto& x = rows("Coordinates");
+    const auto& v = rows("Velocities");
+    content->masses = rows("Masses");
+    content->positions.resize(file.count);
+    content->velocities.resize(file.count);
+    for (std::size_t i = 0; i < file.count; ++i) {
+      content->positions[i] = {x[3 * i], x[3 * i + 1], x[3 * i + 2]};
+      content->velocities[i] = {v[3 * i], v[3 * i + 1], v[3 * i + 2]};
+    }
+    content->unit_system = std::move(file.unit_system);
+    if (file.cgs_units)
+      content->cgs_units = std::array<double, 3>{file.cgs_units->length, file.cgs_units->mass, file.cgs_units->time};
+    src.content = std::move(content);
+  } catch (const io::IoError& e) {
+    t.fail("file", e.what());  // names the file, the group or dataset, and the reason
+  }
+}
+
 void read_particles(const Table& top, Scene& s) {
   const Reader& r = top.reader();
   if (s.random_box) return;  // its one source was made by read_random_box()
@@ -486,6 +566,7 @@ void read_particles(const Table& top, Scene& s) {
     for (const auto& spec : kind.keys)
       if (!spec.custom_read) t.read(spec, spec.key, source);
     if (auto* list_source = std::get_if<ListSource>(&source)) read_list(t, *list_source);
+    if (auto* snapshot = std::get_if<SnapshotSource>(&source)) read_snapshot_file(t, *snapshot);
     if (kind.name == "fluid_block") {
       // Its mass is the one that gives the rest density.
       auto& lattice = std::get<LatticeSource>(source);
@@ -646,6 +727,12 @@ Scene parse_scene(std::string_view text, std::string_view file, std::span<const 
   const Reader r(file);
   for (const auto& o : overrides) apply_override(root, o, r);
   Scene scene = read_scene(root, file);
+  // Each snapshot source's file as resolved (absolute), so that the TOML saved
+  // with a run names it from any working directory (read_snapshot_file).
+  if (auto* list = root["particles"].as_array(); list && !scene.random_box)
+    for (std::size_t i = 0; i < scene.sources.size() && i < list->size(); ++i)
+      if (const auto* snapshot = std::get_if<SnapshotSource>(&scene.sources[i]))
+        if (auto* table = (*list)[i].as_table()) table->insert_or_assign("file", snapshot->file);
   std::ostringstream effective;
   effective << root;
   scene.toml = effective.str();

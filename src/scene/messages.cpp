@@ -69,6 +69,10 @@ void check_value(const KeySpec<Owner>& spec, const KeyValue& value, std::string_
             fail(file, where, fmt::format("must be {}, got {}", spec.range.text(), v));
         } else if constexpr (std::is_same_v<T, std::string_view>) {
           if (spec.type == KeyType::Name) check_name(spec, v, file, where);
+          // A path is handed to C APIs, which would stop at a NUL and open another file.
+          if (spec.type == KeyType::Text && v.empty()) fail(file, where, "must not be empty");
+          if (spec.type == KeyType::Text && v.find('\0') != std::string_view::npos)
+            fail(file, where, "must not hold a NUL character");
         } else if constexpr (std::is_same_v<T, Vec3d>) {
           check_vector(v, file, where);
         } else if constexpr (std::is_same_v<T, std::vector<std::string_view>>) {

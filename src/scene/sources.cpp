@@ -39,6 +39,7 @@ std::uint64_t source_count(const ParticleSource& source) {
     std::uint64_t operator()(const RandomSource& s) const { return s.count; }
     std::uint64_t operator()(const ListSource& s) const { return s.positions.size(); }
     std::uint64_t operator()(const StellarSource& s) const { return s.count; }
+    std::uint64_t operator()(const SnapshotSource& s) const { return s.content ? s.content->positions.size() : 0; }
   } count;
   return std::visit(count, source);
 }
@@ -124,6 +125,12 @@ class Filler {
           model.velocity.get(n).template cast<double>() + s.velocity, double(model.mass[n]));
   }
 
+  void operator()(const SnapshotSource& s) {
+    const SnapshotContent& c = *s.content;  // check_buildable() refused a source without it
+    for (std::size_t n = 0; n < c.positions.size(); ++n)
+      put(detail::moved(c.positions[n], s.offset), detail::moved(c.velocities[n], s.velocity), c.masses[n]);
+  }
+
   std::size_t count() const { return next_; }
 
  private:
@@ -163,6 +170,11 @@ void check_buildable(const Scene& scene, std::uint64_t count) {
                  (!list->velocities.empty() && list->velocities.size() != list->positions.size())))
       throw SceneError(fmt::format("{}: particles[{}]: masses and velocities must have one entry per position",
                                    scene.file, k));
+    const auto* snapshot = std::get_if<SnapshotSource>(&scene.sources[k]);
+    if (snapshot && (!snapshot->content || snapshot->content->velocities.size() != snapshot->content->positions.size() ||
+                     snapshot->content->masses.size() != snapshot->content->positions.size()))
+      throw SceneError(fmt::format("{}: particles[{}].file: {} has not been read (load_scene reads it)", scene.file, k,
+                                   snapshot->file));
   }
 }
 

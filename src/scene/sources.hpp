@@ -1,5 +1,6 @@
-// Internal to the scene module: particle counts, shared by validation (which
-// must refuse huge scenes before anything allocates) and by make_particles.
+// Internal to the scene module: particle counts and placement, shared by
+// validation (which must refuse huge scenes before anything allocates, and
+// particles outside the box) and by make_particles.
 #pragma once
 
 #include <array>
@@ -23,6 +24,14 @@ std::array<std::uint64_t, 3> lattice_counts(const LatticeSource& source);
 
 // Particles one source makes, saturating at kSaturated.
 std::uint64_t source_count(const ParticleSource& source);
+
+// x moved by `by`, adding only the non-zero components: x + 0.0 turns a −0.0
+// into +0.0, and a snapshot read back must give its particles bit for bit.
+inline Vec3d moved(Vec3d x, const Vec3d& by) {
+  for (int axis = 0; axis < 3; ++axis)
+    if (by[axis] != 0) x[axis] += by[axis];
+  return x;
+}
 
 // a + b and a * b, saturating at kSaturated.
 constexpr std::uint64_t add_sat(std::uint64_t a, std::uint64_t b) { return a > kSaturated - b ? kSaturated : a + b; }

@@ -105,6 +105,7 @@ class Checker {
       if (const auto* l = std::get_if<LatticeSource>(&source)) lattice(*l, where);
       else if (const auto* r = std::get_if<RandomSource>(&source)) region(r->region, where);
       else if (const auto* list = std::get_if<ListSource>(&source)) listed(*list, where);
+      else if (const auto* snapshot = std::get_if<SnapshotSource>(&source)) snapshot_file(*snapshot, where);
       else stellar(std::get<StellarSource>(source), where);
       const std::uint64_t n = detail::source_count(source);
       if (n > detail::kMaxParticles)
@@ -159,6 +160,55 @@ class Checker {
     if (l.masses.size() != l.positions.size())
       fail(fmt::format("{}.masses", where),
            fmt::format("has {} entries but {} has {}", l.masses.size(), positions, l.positions.size()));
+  }
+
+  // What load_scene read from the file, against the scene: the counts, the
+  // units the file says it is in, positive masses, the box.
+  void snapshot_file(const SnapshotSource& src, std::string_view where) const {
+    const std::string key = fmt::format("{}.file", where);
+    if (!src.content) fail(key, fmt::format("{} has not been read (load_scene reads it; a Scene built in code must "
+                                            "fill SnapshotSource::content)", src.file));
+    const SnapshotContent& c = *src.content;
+    const std::size_t n = c.positions.size();
+    if (n == 0) fail(key, fmt::format("{}: {} holds no particles", src.file, c.group));
+    if (c.velocities.size() != n || c.masses.size() != n)
+      fail(key, fmt::format("{}: the content read has {} positions, {} velocities and {} masses", src.file, n,
+                            c.velocities.size(), c.masses.size()));
+    snapshot_units(c, src.file, key);
+    for (std::size_t i = 0; i < n; ++i)
+      if (!(c.masses[i] > 0))
+        fail(key, fmt::format("{}: {}/Masses: particle {} has mass {}; masses must be > 0", src.file, c.group, i,
+                              c.masses[i]));
+    if (!s_.walls) return;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec3d p = detail::moved(c.positions[i], src.offset);
+      if (!s_.box.contains(p))
+        fail(key, fmt::format("{}: {}/Coordinates: particle {} at {}{} lies outside the box {}", src.file, c.group, i,
+                              detail::vec_text(p), src.offset == Vec3d{} ? "" : " (with the offset)",
+                              detail::box_text(s_.box)));
+    }
+  }
+
+  // A file that says which units it is in must say the scene's: swirl does
+  // not convert (a file in kpc, 10¹⁰ M☉ and km/s is refused, naming its factors).
+  void snapshot_units(const SnapshotContent& c, std::string_view file, std::string_view key) const {
+    const std::string_view units = enum_name<Units>(kUnitsNames, s_.units);
+    if (!c.unit_system.empty() && c.unit_system != units)
+      fail(key, fmt::format("{}: /Header/UnitSystem is \"{}\", but the scene's simulation.units is \"{}\": its "
+                            "numbers would be taken in the wrong units",
+                            file, c.unit_system, units));
+    if (!c.cgs_units) return;
+    const auto& u = *c.cgs_units;
+    const auto near = [](double a, double b) { return std::abs(a - b) <= 1e-9 * b; };
+    if (s_.units == Units::SI && near(u[0], 100) && near(u[1], 1000) && near(u[2], 1)) return;
+    const std::string factors = fmt::format("/Units gives U_L = {} cm, U_M = {} g, U_t = {} s", u[0], u[1], u[2]);
+    if (s_.units == Units::SI)
+      fail(key, fmt::format("{}: {}, not SI's m, kg and s (100, 1000, 1): swirl does not convert units; convert the "
+                            "file's numbers to SI",
+                            file, factors));
+    fail(key, fmt::format("{}: {}, physical units, but the scene's simulation.units is \"nbody\" (G = 1): swirl does "
+                          "not convert units; use simulation.units = \"si\" with a file in m, kg and s",
+                          file, factors));
   }
 
   void stellar(const StellarSource& m, std::string_view where) const {

@@ -6,8 +6,12 @@ swirl's, for tests/io/snapshot_test.cpp.
 
 KIND "ics" is a valid set of initial conditions in the form the community's
 generators write (five type-1 particles, the mass in MassTable, no Masses and
-no Velocities datasets, float32 coordinates); every other kind is that file
-with one thing wrong, which swirl must refuse naming it.
+no Velocities datasets, float32 coordinates); "gas_and_halo" adds three type-0
+particles with float64 Masses and Velocities of their own (read one type at a
+time, for tests/scene/snapshot_source_test.cpp), "nbody_units" says
+UnitSystem = "nbody" and "kpc_units" has a /Units group in kpc, 1e10 Msun and
+km/s (SWIFT's attribute names). Every other kind is the "ics" file with one
+thing wrong, which swirl must refuse naming it.
 """
 import sys
 
@@ -34,9 +38,27 @@ def write(kind, path):
             h.attrs["Time"] = 0.5
             h.attrs["Redshift"] = 0.0
             h.attrs["BoxSize"] = 0.0
-            h.attrs["NumFilesPerSnapshot"] = 1
+            h.attrs["NumFilesPerSnapshot"] = 2 if kind == "split" else 1
             if kind == "future":
                 h.attrs["SwirlFormatVersion"] = 99
+            if kind == "nbody_units":
+                h.attrs["UnitSystem"] = np.bytes_(b"nbody")
+            if kind == "gas_and_halo":
+                counts[0] = 3
+                h.attrs["NumPart_ThisFile"] = counts
+                h.attrs["NumPart_Total"] = counts
+        if kind == "kpc_units":
+            u = f.create_group("Units")
+            for name, value in [("Unit length in cgs (U_L)", 3.08567758e21), ("Unit mass in cgs (U_M)", 1.98841e43),
+                                ("Unit time in cgs (U_t)", 3.08567758e16), ("Unit current in cgs (U_I)", 1.0),
+                                ("Unit temperature in cgs (U_T)", 1.0)]:
+                u.attrs[name] = np.array([value])
+        if kind == "gas_and_halo":
+            gas = f.create_group("PartType0")
+            gas["Coordinates"] = np.array([[0.5, -0.25, 1.0 / 3.0], [-0.0, 2.0, 1e-300], [-1.5, 0.125, 7.0]])
+            gas["Velocities"] = np.array([[1.0, 2.0, 3.0], [-0.0, 0.1, -0.2], [4.0, 5.0, 6.0]])
+            gas["Masses"] = np.array([0.3, 0.1, 0.7])
+            gas["ParticleIDs"] = np.arange(3, dtype=np.uint64)
         g = f.create_group("PartType1")
         x = np.zeros((n, 3), dtype=np.float32)
         x[:, 1] = 0.1 * np.arange(n)

@@ -1,9 +1,11 @@
 // HDF5 snapshots (io/snapshot.hpp): every field round-trips exactly, the same
 // state gives the same bytes, files written by an independent writer (h5py,
-// tests/io/gadget_files.py) are read, and bad files are refused naming the
+// tests/io/gadget_files.py) are read one particle type at a time with their
+// unit attributes reported, and bad files are refused naming the
 // dataset.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <string>
@@ -147,6 +149,49 @@ TEST(Snapshot, AFileWrittenByH5pyIsRead) {
   EXPECT_EQ(s.info.time, 0.5);
 }
 
+// A file with several types is read one type at a time, any of Gadget's six
+// when asked for; what the file says of its units is reported, not applied.
+TEST(Snapshot, OneTypeAtATimeAndTheFilesUnitsAreReported) {
+  TempDir dir;
+  gadget_file(dir.path(), "gas_and_halo");  // 3 of type 0 with Masses, 5 of type 1 by MassTable
+  EXPECT_EQ(snapshot_particle_counts(dir / "gas_and_halo.h5"), (std::array<std::uint64_t, 6>{3, 5, 0, 0, 0, 0}));
+  const SnapshotFile gas = read_snapshot(dir / "gas_and_halo.h5", 0);
+  EXPECT_EQ(gas.info.type, PartType::Gas);
+  ASSERT_EQ(gas.count, 3u);
+  EXPECT_EQ(gas.datasets.at("Masses").values, (std::vector<double>{0.3, 0.1, 0.7}));
+  const SnapshotFile halo = read_snapshot(dir / "gas_and_halo.h5", 1);
+  ASSERT_EQ(halo.count, 5u);
+  EXPECT_EQ(halo.datasets.at("Masses").values, std::vector<double>(5, 0.2));
+  EXPECT_NE(error_of(dir / "gas_and_halo.h5").find("has particles of types 0 and 1"), std::string::npos);
+  try {
+    read_snapshot(dir / "gas_and_halo.h5", 4);
+    ADD_FAILURE() << "a missing group was read";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("/PartType4: missing (the file has /PartType0, /PartType1)"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_TRUE(halo.unit_system.empty());
+  EXPECT_FALSE(halo.cgs_units);
+
+  gadget_file(dir.path(), "kpc_units");
+  const SnapshotFile kpc = read_snapshot(dir / "kpc_units.h5");
+  ASSERT_TRUE(kpc.cgs_units);
+  EXPECT_EQ(kpc.cgs_units->length, 3.08567758e21);
+  EXPECT_EQ(kpc.cgs_units->mass, 1.98841e43);
+  EXPECT_EQ(kpc.cgs_units->time, 3.08567758e16);
+  gadget_file(dir.path(), "nbody_units");
+  EXPECT_EQ(read_snapshot(dir / "nbody_units.h5").unit_system, "nbody");
+
+  // swirl's own SI frames say so both ways.
+  write_snapshot(dir / "si.h5", test::make_particles<double>(2), SnapshotInfo{});
+  const SnapshotFile si = read_snapshot(dir / "si.h5");
+  EXPECT_EQ(si.unit_system, "si");
+  ASSERT_TRUE(si.cgs_units);
+  EXPECT_EQ(si.cgs_units->length, 100.0);
+  EXPECT_EQ(si.cgs_units->mass, 1000.0);
+  EXPECT_EQ(si.cgs_units->time, 1.0);
+}
+
 TEST(Snapshot, BadFilesAreRefusedNamingTheDataset) {
   TempDir dir;
   for (const auto& [kind, expected] : std::vector<std::pair<std::string, std::string>>{
@@ -159,6 +204,7 @@ TEST(Snapshot, BadFilesAreRefusedNamingTheDataset) {
            {"no_mass", "/PartType1/Masses: missing, and /Header/MassTable gives no mass"},
            {"string_coordinates", "/PartType1/Coordinates: is not numeric"},
            {"future", "/Header/SwirlFormatVersion: is 99, newer than this swirl's"},
+           {"split", "/Header/NumFilesPerSnapshot: is 2: this file is one part of a snapshot split"},
        }) {
     SCOPED_TRACE(kind);
     gadget_file(dir.path(), kind);

@@ -19,7 +19,10 @@ KeyValue changed(const KeySpec<Owner>& spec, const KeyValue& value) {
         if constexpr (std::is_same_v<T, double>) return v * 0.5 + 0.125;  // no fixed point among the defaults (0.25 is)
         else if constexpr (std::is_same_v<T, std::uint64_t>) return v + 1;
         else if constexpr (std::is_same_v<T, bool>) return !v;
-        else if constexpr (std::is_same_v<T, std::string_view>) return spec.names.at(spec.names.at(0) == v ? 1 : 0);
+        else if constexpr (std::is_same_v<T, std::string_view>) {
+          if (spec.type == KeyType::Text) return std::string_view(v == "/a" ? "/b" : "/a");  // a path
+          return spec.names.at(spec.names.at(0) == v ? 1 : 0);
+        }
         else if constexpr (std::is_same_v<T, Vec3d>) return Vec3d{v.x + 1, v.y, v.z};
         else if constexpr (std::is_same_v<T, std::vector<std::string_view>>) return std::vector{spec.names.back()};
         else if constexpr (std::is_same_v<T, std::vector<Vec3d>>) return std::vector<Vec3d>{{1, 2, 3}};

@@ -27,11 +27,14 @@
 // Datasets are chunked and deflated (with the shuffle filter); object times are
 // not recorded, so the same state gives the same bytes.
 //
-// Reading accepts any file with that layout (one particle type, masses either
-// per particle or from MassTable) and refuses anything else with an IoError
-// naming the file and the group, dataset or attribute, and the reason:
-// missing, wrong shape or type, a count that disagrees with the header, a value
-// that is not finite.
+// Reading accepts any file with that layout (masses either per particle or
+// from MassTable) and refuses anything else with an IoError naming the file
+// and the group, dataset or attribute, and the reason: missing, wrong shape or
+// type, a count that disagrees with the header, a value that is not finite,
+// one part of a snapshot split over several files (NumFilesPerSnapshot > 1).
+// One particle type is read at a time: the one asked for (any of Gadget's six,
+// as initial-condition files split a galaxy into halo, disk and bulge types),
+// or else the only type 0 or 1 the file has particles of.
 #pragma once
 
 #include <array>
@@ -39,6 +42,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,8 +52,10 @@ namespace swirl::io {
 
 inline constexpr int kSnapshotVersion = 1;
 
-// Gadget's particle types that swirl writes.
+// Gadget's particle types that swirl writes. A file read may hold any of the
+// six (0 to 5; kGadgetTypes), which read_snapshot reports as PartType(k).
 enum class PartType : int { Gas = 0, Collisionless = 1 };
+inline constexpr int kGadgetTypes = 6;
 
 // What a snapshot says beside its particles.
 struct SnapshotInfo {
@@ -100,15 +106,31 @@ struct SnapshotDataset {
   std::vector<double> values;  // rows × columns
 };
 
+// A /Units group's scale factors (SWIFT's names, "Unit length in cgs (U_L)",
+// ...): how many cm, g and s one unit of the file's length, mass and time is.
+struct CgsUnits {
+  double length = 0;  // U_L, cm
+  double mass = 0;    // U_M, g
+  double time = 0;    // U_t, s
+};
+
 struct SnapshotFile {
   SnapshotInfo info;
   int version = 0;                         // SwirlFormatVersion; 0 for files from other codes
+  std::string unit_system;                 // /Header/UnitSystem as written ("si", "nbody"); "" when absent
+  std::optional<CgsUnits> cgs_units;       // /Units; nullopt when the file has no such group
   std::size_t count = 0;                   // particles of the one type present
   std::vector<std::uint64_t> ids;          // ParticleIDs (0..count−1 when absent)
   std::map<std::string, SnapshotDataset> datasets;  // by name; Coordinates, Velocities, Masses always present
 };
 
-// Reads a snapshot (see the header comment). Throws IoError.
-SnapshotFile read_snapshot(const std::filesystem::path& path);
+// Particles of each Gadget type, from /Header/NumPart_ThisFile (the header
+// only: no group or dataset is looked at). Throws IoError.
+std::array<std::uint64_t, kGadgetTypes> snapshot_particle_counts(const std::filesystem::path& path);
+
+// Reads a snapshot (see the header comment): the particles of `part_type`
+// (0 to 5) when given, else of the only type the file has particles of (0 or
+// 1; a file with several is refused). Throws IoError.
+SnapshotFile read_snapshot(const std::filesystem::path& path, std::optional<int> part_type = std::nullopt);
 
 }  // namespace swirl::io

@@ -46,12 +46,14 @@ struct Range {
 };
 
 // What a key holds, in file terms. Vectors are arrays of exactly 3 numbers.
-enum class KeyType { Number, Integer, Boolean, Name, NameList, Vector, VectorList, NumberList };
+// A Name is one of a list; a Text is any non-empty string (a path).
+enum class KeyType { Number, Integer, Boolean, Name, NameList, Vector, VectorList, NumberList, Text };
 
 // A key's value, whatever its type: Number → double, Integer → uint64_t,
 // Boolean → bool, Name → string_view (one of the key's names), NameList →
 // vector<string_view>, Vector → Vec3d, VectorList → vector<Vec3d>,
-// NumberList → vector<double>.
+// NumberList → vector<double>, Text → string_view (into the owner's
+// std::string, or the TOML node read: valid while that lives).
 using KeyValue = std::variant<double, std::uint64_t, bool, std::string_view, Vec3d, std::vector<std::string_view>,
                               std::vector<Vec3d>, std::vector<double>>;
 
@@ -111,7 +113,8 @@ std::span<const SourceKind> source_kinds();
 const SourceKind& kind_of(const ParticleSource& source);
 
 // `value` as TOML: numbers with 17 significant digits when `exact`, else the
-// shortest text that reads back the same.
+// shortest text that reads back the same; strings as basic strings, with `"`,
+// `\` and control characters escaped.
 std::string value_text(const KeyValue& value, bool exact);
 
 // The docs' key table of one section ("simulation", "sph", ..., "particles"

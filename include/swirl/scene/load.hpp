@@ -9,7 +9,11 @@
 //   [forces]      gravity = [gx, gy, gz], damping
 //   [output]      interval, format = "vtp" | "csv" | ["vtp", "csv"]
 //   [sph], [nbody], [random_box]
-//   [[particles]] kind = "lattice" | "random" | "list" | "fluid_block" | a stellar model, and the kind's keys
+//   [[particles]] kind = "lattice" | "random" | "list" | "fluid_block" | a stellar model | "snapshot", and the kind's keys
+//
+// A "snapshot" source's file is resolved against the folder of `file` (the
+// working directory when it names none, as "<dict>" does) and read while the
+// scene is loaded; Scene::toml then names it by that absolute path.
 //
 // Unknown keys are errors that suggest the closest known key. The scene read
 // is then checked by validate() (scene/validate.hpp), as a Scene built in code is.

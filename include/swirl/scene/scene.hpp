@@ -13,6 +13,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -107,7 +108,32 @@ inline constexpr std::array<EnumName<StellarSource::Model>, 6> kStellarModelName
     {"hernquist", StellarSource::Model::Hernquist},
 }};
 
-using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource>;
+// What a snapshot source's file held, as read when the scene was loaded: its
+// particles in file order (in double, exact for float and double files) and
+// what the file says of its units, for validate() to compare with the scene's.
+struct SnapshotContent {
+  std::string group;                 // "/PartType1": the group read, for messages
+  std::vector<Vec3d> positions;      // Coordinates
+  std::vector<Vec3d> velocities;     // Velocities (zero when the file has none)
+  std::vector<double> masses;        // Masses, or the header's MassTable entry
+  std::string unit_system;           // /Header/UnitSystem ("si", "nbody"); "" when absent
+  std::optional<std::array<double, 3>> cgs_units;  // /Units U_L, U_M, U_t (cm, g, s); nullopt when absent
+};
+
+// Particles read from a Gadget-format HDF5 file (io/snapshot.hpp), one per row
+// of /PartType<part_type>, moved by `offset` and given the extra `velocity`.
+struct SnapshotSource {
+  std::string file;                        // an absolute, lexically normal path once loaded (load_scene
+                                           // resolves a relative one against the scene file's folder)
+  std::optional<std::uint64_t> part_type;  // 0 to 5; nullopt: the only type the file has particles of
+  Vec3d offset{};
+  Vec3d velocity{};
+  // Filled by load_scene, which reads the file; shared by copies of the Scene.
+  // A Scene built in code must fill it too (validate() refuses a source without it).
+  std::shared_ptr<const SnapshotContent> content;
+};
+
+using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource, SnapshotSource>;
 
 struct Scene {
   std::string file;                        // where it came from, for messages
