@@ -601,7 +601,7 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
                               .required = true},
                     in_source(&StellarSource::count)));
   k.push_back(seed_key<StellarSource>("seeds the model"));
-  // A field of one model's options (StellarSource::plummer, ::collision, ::hernquist).
+  // A field of one model's options (StellarSource::plummer, ::collision, ::hernquist, ::nfw, ::king).
   const auto in_options = [](auto options, auto member) {
     return [options, member](auto& src) {
       auto* m = std::get_if<StellarSource>(&src);
@@ -658,6 +658,27 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
                         halo(&gravity::HernquistOptions::mass_cut)));
       break;
     }
+    case Model::Nfw: {
+      const auto halo = [&](auto member) { return in_options(&StellarSource::nfw, member); };
+      k.push_back(field(SourceKey{.key = "concentration", .range = Range{1, 100, false, false},
+                                  .doc = "c = r_vir/r_s: the density falls as r⁻¹ inside the scale radius r_s and "
+                                         "r⁻³ outside, out to r_vir"},
+                        halo(&gravity::NfwOptions::concentration)));
+      k.push_back(field(SourceKey{.key = "decay", .unit = "fraction of r_vir", .range = Range{0.01, 1, false, false},
+                                  .doc = "r_d: beyond r_vir the density is cut off as exp(−(r − r_vir)/r_d)"},
+                        halo(&gravity::NfwOptions::decay)));
+      k.push_back(field(SourceKey{.key = "virial_radius", .unit = "length", .range = kPositive,
+                                  .doc = "r_vir, where the cut-off starts",
+                                  .default_doc = "Hénon units (E = −1/4)"},
+                        halo(&gravity::NfwOptions::virial_radius)));
+      break;
+    }
+    case Model::King:
+      k.push_back(field(SourceKey{.key = "w0", .range = Range{0.1, 16, false, false},
+                                  .doc = "W₀ = Ψ(0)/σ², the dimensionless central potential: 3, 6, 9 give "
+                                         "concentrations log₁₀(r_t/r₀) of 0.67, 1.26, 2.12"},
+                        in_options(&StellarSource::king, &gravity::KingOptions::w0)));
+      break;
   }
   k.push_back(field(SourceKey{.key = "offset", .unit = "length", .doc = "moves the whole model"},
                     in_source(&StellarSource::offset)));

@@ -24,6 +24,7 @@
 #include "swirl/core/vec3.hpp"
 #include "swirl/gravity/initial_conditions.hpp"
 #include "swirl/gravity/settings.hpp"
+#include "swirl/gravity/spherical_models.hpp"
 #include "swirl/sph/parameters.hpp"
 
 namespace swirl::scene {
@@ -76,10 +77,11 @@ struct ListSource {
   std::vector<double> masses;     // one per position
 };
 
-// A self-gravitating model from gravity/initial_conditions.hpp (G = 1 units),
+// A self-gravitating model from gravity/initial_conditions.hpp or
+// gravity/spherical_models.hpp (G = 1 units),
 // moved by `offset` and given the extra bulk `velocity`.
 struct StellarSource {
-  enum class Model { Plummer, UniformSphere, UniformCube, ColdCollapse, PlummerCollision, Hernquist };
+  enum class Model { Plummer, UniformSphere, UniformCube, ColdCollapse, PlummerCollision, Hernquist, Nfw, King };
   Model model = Model::Plummer;
   std::size_t count = 0;
   std::uint64_t seed = 1;
@@ -88,18 +90,22 @@ struct StellarSource {
   gravity::PlummerOptions plummer;      // plummer
   gravity::CollisionOptions collision;  // plummer_collision
   gravity::HernquistOptions hernquist;  // hernquist
+  gravity::NfwOptions nfw;              // nfw
+  gravity::KingOptions king;            // king
   Vec3d offset{};
   Vec3d velocity{};
 };
 
 // The stellar models' names, which are also their [[particles]] kinds.
-inline constexpr std::array<EnumName<StellarSource::Model>, 6> kStellarModelNames{{
+inline constexpr std::array<EnumName<StellarSource::Model>, 8> kStellarModelNames{{
     {"plummer", StellarSource::Model::Plummer},
     {"uniform_sphere", StellarSource::Model::UniformSphere},
     {"uniform_cube", StellarSource::Model::UniformCube},
     {"cold_collapse", StellarSource::Model::ColdCollapse},
     {"plummer_collision", StellarSource::Model::PlummerCollision},
     {"hernquist", StellarSource::Model::Hernquist},
+    {"nfw", StellarSource::Model::Nfw},
+    {"king", StellarSource::Model::King},
 }};
 
 using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource>;
