@@ -601,7 +601,7 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
                               .required = true},
                     in_source(&StellarSource::count)));
   k.push_back(seed_key<StellarSource>("seeds the model"));
-  // A field of one model's options (StellarSource::plummer, ::collision, ::hernquist, ::nfw, ::king).
+  // A field of one model's options (StellarSource::plummer, ::collision, ::hernquist, ::nfw, ::king, ::disk).
   const auto in_options = [](auto options, auto member) {
     return [options, member](auto& src) {
       auto* m = std::get_if<StellarSource>(&src);
@@ -679,6 +679,35 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
                                          "concentrations log₁₀(r_t/r₀) of 0.67, 1.26, 2.12"},
                         in_options(&StellarSource::king, &gravity::KingOptions::w0)));
       break;
+    case Model::DiskGalaxy: {
+      const auto disk = [&](auto member) { return in_options(&StellarSource::disk, member); };
+      using O = gravity::DiskGalaxyOptions;
+      k.push_back(field(SourceKey{.key = "disk_mass", .unit = "mass", .range = Range{0, 1, true, true},
+                                  .doc = "M_d, of a total mass 1 (the halo has 1 − M_d)"},
+                        disk(&O::disk_mass)));
+      k.push_back(field(SourceKey{.key = "disk_scale_length", .unit = "length", .range = kPositive,
+                                  .doc = "h: Σ ∝ exp(−R/h)"},
+                        disk(&O::disk_scale_length)));
+      k.push_back(field(SourceKey{.key = "disk_scale_height", .unit = "length", .range = kPositive,
+                                  .doc = "z₀: ρ ∝ sech²(z/z₀)"},
+                        disk(&O::disk_scale_height)));
+      k.push_back(field(SourceKey{.key = "disk_cut", .unit = "scale lengths", .range = Range{2, 50, false, false},
+                                  .doc = "the disk's radius"},
+                        disk(&O::disk_cut)));
+      k.push_back(field(SourceKey{.key = "toomre_q", .range = kPositive,
+                                  .doc = "Toomre's Q = σ_R κ/(3.36 GΣ) at R = 2.43 h: above 1 the disk is locally stable"},
+                        disk(&O::toomre_q)));
+      k.push_back(field(SourceKey{.key = "halo_scale_radius", .unit = "length", .range = kPositive,
+                                  .doc = "a of the Hernquist halo"},
+                        disk(&O::halo_scale_radius)));
+      k.push_back(field(SourceKey{.key = "halo_mass_cut", .range = Range{0, 1, true, true},
+                                  .doc = "the fraction of the halo's mass kept (0.99: out to 199 a)"},
+                        disk(&O::halo_mass_cut)));
+      k.push_back(field(SourceKey{.key = "disk_particles", .range = Range{0, 1, true, true},
+                                  .doc = "the disk's share of `count` (the rest are the halo's)"},
+                        disk(&O::disk_particles)));
+      break;
+    }
   }
   k.push_back(field(SourceKey{.key = "offset", .unit = "length", .doc = "moves the whole model"},
                     in_source(&StellarSource::offset)));

@@ -120,6 +120,7 @@ class Filler {
       case Model::Hernquist: model = gravity::hernquist<Real>(s.count, s.seed, s.hernquist); break;
       case Model::Nfw: model = gravity::nfw<Real>(s.count, s.seed, s.nfw); break;
       case Model::King: model = gravity::king<Real>(s.count, s.seed, s.king); break;
+      case Model::DiskGalaxy: model = gravity::disk_galaxy<Real>(s.count, s.seed, s.disk); break;
     }
     for (std::size_t n = 0; n < model.size(); ++n)
       put(model.position.get(n).template cast<double>() + s.offset,

@@ -3,6 +3,7 @@
 
 #include <string>
 
+#include "swirl/gravity/disk_galaxy.hpp"
 #include "swirl/gravity/spherical_models.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/load.hpp"
@@ -158,6 +159,24 @@ offset = [20.0, 0.0, 0.0]
             "g.toml: particles[0].virial_radius: must be > 0, got 0");
   EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"king\"", "particles.0.concentration=5"}),
             "g.toml: particles[0].concentration: unknown key for kind 'king'");
+}
+
+TEST(NbodyScene, DiskGalaxyIsASceneKindWithItsOptions) {
+  const Scene s = parse_scene(kPlummer, "g.toml",
+                              std::vector<std::string>{"particles.0.kind=\"disk_galaxy\"", "particles.0.disk_mass=0.1",
+                                                       "particles.0.toomre_q=2", "particles.0.disk_particles=0.25"});
+  swirl::gravity::DiskGalaxyOptions o;
+  o.disk_mass = 0.1;
+  o.toomre_q = 2;
+  o.disk_particles = 0.25;
+  const auto p = make_particles<double>(s);
+  const auto direct = swirl::gravity::disk_galaxy<double>(1000, 3, o);
+  EXPECT_EQ(p.position.z, direct.position.z);
+  EXPECT_EQ(p.velocity.x, direct.velocity.x);
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"disk_galaxy\"", "particles.0.disk_particles=0.0001"}),
+            "g.toml: particles[0].disk_particles: 0.0001 of 1000 particles leaves the disk or the halo empty");
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"disk_galaxy\"", "particles.0.disk_cut=1"}),
+            "g.toml: particles[0].disk_cut: must be in [2, 50], got 1");
 }
 
 }  // namespace
