@@ -234,11 +234,11 @@ ParticleSet<Real> disk_galaxy(std::size_t n, std::uint64_t seed, const DiskGalax
   std::vector<double> q;
   const RadialTable t = halo_table(o, q);
   const detail::TabulatedDf df = detail::eddington(t, q);
-  if (detail::most_negative_fraction(df) < -1e-6)
-    throw std::invalid_argument(
-        fmt::format("disk_galaxy: no isotropic halo is in equilibrium with disk_mass = {} and disk_scale_length = {} "
-                    "(its distribution function is negative)",
-                    o.disk_mass, o.disk_scale_length));
+  if (!(detail::most_negative_fraction(df) >= -1e-6))  // NaN too: tables spoilt by extreme scales
+    throw std::invalid_argument(fmt::format(
+        "disk_galaxy: no isotropic halo is in equilibrium with disk_mass = {}, disk_scale_length = {} and "
+        "halo_scale_radius = {} (its distribution function is negative or not finite)",
+        o.disk_mass, o.disk_scale_length, o.halo_scale_radius));
   const auto f = [&df](double e) { return df(e); };
   const auto majorant = [&df](double e) { return df.majorant(e); };
   SplitMix64 rng(seed);

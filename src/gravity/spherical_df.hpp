@@ -73,7 +73,9 @@ double most_negative_fraction(const TabulatedDf& df);
 // on each of 64 equal bins of x = v/v_esc, x² ≤ x_hi² and f(ε) ≤ majorant(ε_hi),
 // where majorant(e) ≥ f on [0, e] and does not decrease (for a non-decreasing
 // f, f itself). The envelope is a true bound whatever the shape of f, so the
-// sample follows the density exactly.
+// sample follows the density exactly. std::invalid_argument if the envelope
+// is not finite and positive or 10⁷ proposals fail (tables spoilt by
+// overflow: unreachable within the models' ranges).
 double sample_speed(SplitMix64& rng, double psi, const std::function<double(double)>& f,
                     const std::function<double(double)>& majorant);
 

@@ -118,7 +118,7 @@ NfwModel nfw_model(const NfwOptions& o) {
   for (std::size_t k = 0; k < n; ++k) q[k] = -p.drho(r[k]) * r[k] * r[k] / m[k];  // dρ/dΨ = ρ′ / (−M/r²)
   model.df = detail::eddington(model.table, q);
   const double negative = detail::most_negative_fraction(model.df);
-  if (negative < -1e-6)
+  if (!(negative >= -1e-6))
     throw std::invalid_argument(
         fmt::format("nfw: decay = {} is too sharp a truncation for concentration = {}: no isotropic distribution "
                     "function makes this density (f(E) reaches {:.2g} of its peak); raise decay",
