@@ -617,7 +617,7 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
                               .required = true},
                     in_source(&StellarSource::count)));
   k.push_back(seed_key<StellarSource>("seeds the model"));
-  // A field of one model's options (StellarSource::plummer, ::collision, ::hernquist).
+  // A field of one model's options (StellarSource::plummer, ::collision, ::hernquist, ::nfw, ::king, ::disk).
   const auto in_options = [](auto options, auto member) {
     return [options, member](auto& src) {
       auto* m = std::get_if<StellarSource>(&src);
@@ -672,6 +672,56 @@ std::vector<SourceKey> stellar_keys(StellarSource::Model model) {
       k.push_back(field(SourceKey{.key = "mass_cut", .range = Range{0, 1, true, true},
                                   .doc = "the fraction of the infinite model's mass kept (0.99: out to 199 a)"},
                         halo(&gravity::HernquistOptions::mass_cut)));
+      break;
+    }
+    case Model::Nfw: {
+      const auto halo = [&](auto member) { return in_options(&StellarSource::nfw, member); };
+      k.push_back(field(SourceKey{.key = "concentration", .range = Range{1, 100, false, false},
+                                  .doc = "c = r_vir/r_s: the density falls as r⁻¹ inside the scale radius r_s and "
+                                         "r⁻³ outside, out to r_vir"},
+                        halo(&gravity::NfwOptions::concentration)));
+      k.push_back(field(SourceKey{.key = "decay", .unit = "fraction of r_vir", .range = Range{0.01, 1, false, false},
+                                  .doc = "r_d: beyond r_vir the density is cut off as exp(−(r − r_vir)/r_d)"},
+                        halo(&gravity::NfwOptions::decay)));
+      k.push_back(field(SourceKey{.key = "virial_radius", .unit = "length", .range = kPositive,
+                                  .doc = "r_vir, where the cut-off starts",
+                                  .default_doc = "Hénon units (E = −1/4)"},
+                        halo(&gravity::NfwOptions::virial_radius)));
+      break;
+    }
+    case Model::King:
+      k.push_back(field(SourceKey{.key = "w0", .range = Range{0.1, 16, false, false},
+                                  .doc = "W₀ = Ψ(0)/σ², the dimensionless central potential: 3, 6, 9 give "
+                                         "concentrations log₁₀(r_t/r₀) of 0.67, 1.26, 2.12"},
+                        in_options(&StellarSource::king, &gravity::KingOptions::w0)));
+      break;
+    case Model::DiskGalaxy: {
+      const auto disk = [&](auto member) { return in_options(&StellarSource::disk, member); };
+      using O = gravity::DiskGalaxyOptions;
+      k.push_back(field(SourceKey{.key = "disk_mass", .unit = "mass", .range = Range{0, 1, true, true},
+                                  .doc = "M_d, of a total mass 1 (the halo has 1 − M_d)"},
+                        disk(&O::disk_mass)));
+      k.push_back(field(SourceKey{.key = "disk_scale_length", .unit = "length", .range = kPositive,
+                                  .doc = "h: Σ ∝ exp(−R/h)"},
+                        disk(&O::disk_scale_length)));
+      k.push_back(field(SourceKey{.key = "disk_scale_height", .unit = "length", .range = kPositive,
+                                  .doc = "z₀: ρ ∝ sech²(z/z₀)"},
+                        disk(&O::disk_scale_height)));
+      k.push_back(field(SourceKey{.key = "disk_cut", .unit = "scale lengths", .range = Range{2, 50, false, false},
+                                  .doc = "the disk's radius"},
+                        disk(&O::disk_cut)));
+      k.push_back(field(SourceKey{.key = "toomre_q", .range = kPositive,
+                                  .doc = "Toomre's Q = σ_R κ/(3.36 GΣ) at R = 2.43 h: above 1 the disk is locally stable"},
+                        disk(&O::toomre_q)));
+      k.push_back(field(SourceKey{.key = "halo_scale_radius", .unit = "length", .range = kPositive,
+                                  .doc = "a of the Hernquist halo"},
+                        disk(&O::halo_scale_radius)));
+      k.push_back(field(SourceKey{.key = "halo_mass_cut", .range = Range{0, 1, true, true},
+                                  .doc = "the fraction of the halo's mass kept (0.99: out to 199 a)"},
+                        disk(&O::halo_mass_cut)));
+      k.push_back(field(SourceKey{.key = "disk_particles", .range = Range{0, 1, true, true},
+                                  .doc = "the disk's share of `count` (the rest are the halo's)"},
+                        disk(&O::disk_particles)));
       break;
     }
   }

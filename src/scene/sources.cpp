@@ -119,6 +119,9 @@ class Filler {
       case Model::ColdCollapse: model = gravity::cold_collapse<Real>(s.count, s.seed); break;
       case Model::PlummerCollision: model = gravity::plummer_collision<Real>(s.count, s.seed, s.collision); break;
       case Model::Hernquist: model = gravity::hernquist<Real>(s.count, s.seed, s.hernquist); break;
+      case Model::Nfw: model = gravity::nfw<Real>(s.count, s.seed, s.nfw); break;
+      case Model::King: model = gravity::king<Real>(s.count, s.seed, s.king); break;
+      case Model::DiskGalaxy: model = gravity::disk_galaxy<Real>(s.count, s.seed, s.disk); break;
     }
     for (std::size_t n = 0; n < model.size(); ++n)
       put(model.position.get(n).template cast<double>() + s.offset,

@@ -216,6 +216,14 @@ class Checker {
     if (s_.walls)
       fail(fmt::format("{}.kind", where),
            fmt::format("'{}' is a self-gravitating model: it needs open space (no [box])", kind));
+    if (m.model == StellarSource::Model::DiskGalaxy) {
+      // Disk and halo each need a particle (disk_galaxy() rounds the disk's share).
+      const double disk = std::round(m.disk.disk_particles * static_cast<double>(m.count));
+      if (disk < 1 || disk > static_cast<double>(m.count) - 1)
+        fail(fmt::format("{}.disk_particles", where),
+             fmt::format("{} of {} particles leaves the disk or the halo empty", m.disk.disk_particles, m.count));
+      return;
+    }
     if (m.model != StellarSource::Model::PlummerCollision) return;
     const auto& c = m.collision;
     const auto key = [&](std::string_view k) { return fmt::format("{}.{}", where, k); };

@@ -3,6 +3,8 @@
 
 #include <string>
 
+#include "swirl/gravity/disk_galaxy.hpp"
+#include "swirl/gravity/spherical_models.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/load.hpp"
 
@@ -114,6 +116,67 @@ TEST(NbodyScene, BadGravityInputIsRefusedClearly) {
   EXPECT_NE(error_of(kPlummer + "[box]\nmin = [-5, -5, -5]\nmax = [5, 5, 5]\n").find("needs open space"), std::string::npos);
   EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"plummer_collision\"", "particles.0.impact_parameter=20"}),
             "g.toml: particles[0].impact_parameter: must be in [0, 10), got 20");
+}
+
+TEST(NbodyScene, NfwAndKingAreSceneKindsWithTheirOptions) {
+  const Scene s = parse_scene(kPlummer + R"(
+[[particles]]
+kind = "nfw"
+count = 300
+seed = 5
+concentration = 5
+decay = 0.2
+virial_radius = 3
+
+[[particles]]
+kind = "king"
+count = 200
+seed = 6
+w0 = 9
+offset = [20.0, 0.0, 0.0]
+)", "g.toml");
+  const auto p = make_particles<double>(s);
+  ASSERT_EQ(p.size(), 1500u);
+  // The scene's particles are the generators' with the scene's options, moved by offset.
+  const auto halo = swirl::gravity::nfw<double>(300, 5, {.concentration = 5, .decay = 0.2, .virial_radius = 3.0});
+  const auto cluster = swirl::gravity::king<double>(200, 6, {.w0 = 9});
+  for (std::size_t i = 0; i < 300; ++i) {
+    EXPECT_EQ(p.position.x[1000 + i], halo.position.x[i]);
+    EXPECT_EQ(p.velocity.z[1000 + i], halo.velocity.z[i]);
+  }
+  for (std::size_t i = 0; i < 200; ++i) {
+    EXPECT_EQ(p.position.x[1300 + i], cluster.position.x[i] + 20.0);
+    EXPECT_EQ(p.velocity.y[1300 + i], cluster.velocity.y[i]);
+  }
+  // Defaults: c = 10, decay 0.1, Hénon units; W₀ = 6.
+  const Scene d = parse_scene(kPlummer, "g.toml", std::vector<std::string>{"particles.0.kind=\"nfw\""});
+  EXPECT_EQ(make_particles<double>(d).position.y, swirl::gravity::nfw<double>(1000, 3).position.y);
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"king\"", "particles.0.w0=20"}),
+            "g.toml: particles[0].w0: must be in [0.1, 16], got 20");
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"nfw\"", "particles.0.concentration=0.5"}),
+            "g.toml: particles[0].concentration: must be in [1, 100], got 0.5");
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"nfw\"", "particles.0.virial_radius=0"}),
+            "g.toml: particles[0].virial_radius: must be > 0, got 0");
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"king\"", "particles.0.concentration=5"}),
+            "g.toml: particles[0].concentration: unknown key for kind 'king'");
+}
+
+TEST(NbodyScene, DiskGalaxyIsASceneKindWithItsOptions) {
+  const Scene s = parse_scene(kPlummer, "g.toml",
+                              std::vector<std::string>{"particles.0.kind=\"disk_galaxy\"", "particles.0.disk_mass=0.1",
+                                                       "particles.0.toomre_q=2", "particles.0.disk_particles=0.25"});
+  swirl::gravity::DiskGalaxyOptions o;
+  o.disk_mass = 0.1;
+  o.toomre_q = 2;
+  o.disk_particles = 0.25;
+  const auto p = make_particles<double>(s);
+  const auto direct = swirl::gravity::disk_galaxy<double>(1000, 3, o);
+  EXPECT_EQ(p.position.z, direct.position.z);
+  EXPECT_EQ(p.velocity.x, direct.velocity.x);
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"disk_galaxy\"", "particles.0.disk_particles=0.0001"}),
+            "g.toml: particles[0].disk_particles: 0.0001 of 1000 particles leaves the disk or the halo empty");
+  EXPECT_EQ(error_of(kPlummer, {"particles.0.kind=\"disk_galaxy\"", "particles.0.disk_cut=1"}),
+            "g.toml: particles[0].disk_cut: must be in [2, 50], got 1");
 }
 
 }  // namespace
