@@ -24,5 +24,6 @@ void add_bench_commands(CLI::App& app, Commands& commands);
 void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands);
 void add_info_command(CLI::App& app, Commands& commands);
 void add_render_command(CLI::App& app, Commands& commands);
+void add_view_command(CLI::App& app, Commands& commands);
 
 }  // namespace swirl::cli

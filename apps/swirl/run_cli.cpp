@@ -7,6 +7,7 @@
 //   swirl bench SUITE [options]                              (bench.cpp)
 //   swirl info                                               (info_command.cpp)
 //   swirl render RUN_DIR [options]                           (render_command.cpp)
+//   swirl view SCENE [options]                               (view_command.cpp)
 //
 // Exit status: 0 done, 1 the run failed (blow-up, write error; render: frames
 // missing), 2 bad input (every usage error, whatever CLI11's own code), 130 /
@@ -40,6 +41,7 @@ int run_cli(int argc, char** argv) {
   swirl::cli::add_bench_commands(app, commands);
   swirl::cli::add_info_command(app, commands);
   swirl::cli::add_render_command(app, commands);
+  swirl::cli::add_view_command(app, commands);
 
   try {
     app.parse(argc, argv);

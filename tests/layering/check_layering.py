@@ -9,7 +9,7 @@ must be placed in it.
 
 The ranks are the layering that holds today (lowest first). docs name the
 coarse layers core; parallel; spatial, io; force, integrate, boundary, sph,
-gravity; scene; sim; render; CLI. Within the solver layer the includes are
+gravity; scene; sim; render, view; CLI. Within the solver layer the includes are
 finer: the steppers (integrate) apply the box (boundary) and return the
 step's scan (force/step_scan.hpp); sph and gravity implement the Solver seam
 (force) and gravity's benchmark steps with a stepper (integrate). So
@@ -32,7 +32,7 @@ RANK = {
     "sph": 6, "gravity": 6,
     "scene": 7,
     "sim": 8,
-    "render": 9,
+    "render": 9, "view": 9,
     "apps": 10,  # apps/swirl: the CLI, above everything
 }
 

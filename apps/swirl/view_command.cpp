@@ -1,0 +1,99 @@
+// swirl view SCENE: runs the scene live and serves the page that shows and
+// steers it (view/live_run.hpp). The URL is printed; Ctrl-C ends the session.
+// Listening beyond 127.0.0.1 (--host) needs a token in the URL, made here from
+// the system's random device, so that only whoever was given the URL can use it.
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "cli.hpp"
+#include "commands.hpp"
+#include "swirl/scene/load.hpp"
+#include "swirl/view/live_run.hpp"
+
+namespace swirl::cli {
+namespace {
+
+std::atomic<bool> g_view_stop{false};
+extern "C" void on_view_signal(int) { g_view_stop.store(true); }
+
+struct ViewArgs {
+  std::string scene;
+  std::vector<std::string> overrides;
+  std::string host = "127.0.0.1";
+  unsigned port = 8765;
+  int threads = 0;
+  double fps = 30;
+  bool paused = false;
+  double seconds = 0;  // stop after this many wall seconds (0: run until Ctrl-C)
+};
+
+std::string random_token() {
+  std::random_device device;
+  std::string token;
+  for (int i = 0; i < 4; ++i) token += fmt::format("{:08x}", device());
+  return token;
+}
+
+int view(const ViewArgs& args) {
+  const scene::Scene scene = load_scene_file(args.scene, args.overrides);
+  view::ViewOptions options;
+  options.server.host = args.host;
+  options.server.port = static_cast<std::uint16_t>(args.port);
+  if (args.host != "127.0.0.1" && args.host != "::1") options.server.token = random_token();
+  options.threads = args.threads;
+  options.fps = args.fps;
+  options.start_paused = args.paused;
+  options.stop = &g_view_stop;
+  options.log = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
+  options.on_listening = [&](const view::LiveServer& server) {
+    fmt::print("swirl view: {} live at {}\n(Ctrl-C ends the session)\n", args.scene, server.url());
+    std::fflush(stdout);
+  };
+  g_view_stop.store(false);
+  std::signal(SIGINT, on_view_signal);
+  std::signal(SIGTERM, on_view_signal);
+  std::unique_ptr<std::thread> timer;
+  if (args.seconds > 0)
+    timer = std::make_unique<std::thread>([s = args.seconds] {
+      const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(s);
+      while (!g_view_stop.load() && std::chrono::steady_clock::now() < end)
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      g_view_stop.store(true);
+    });
+  const view::ViewResult r = view::view_scene(scene, options);
+  if (timer) timer->join();
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
+  fmt::print("swirl view: {} steps in {:.1f} s ({} resets); {} frames sent ({:.1f} MB), {} controls, {} dropped, {} viewers\n",
+             r.steps, r.wall_seconds, r.resets, r.server.frames_sent, double(r.server.bytes_sent) / 1e6, r.server.controls,
+             r.server.dropped, r.server.sessions);
+  return 0;
+}
+
+}  // namespace
+
+void add_view_command(CLI::App& app, Commands& commands) {
+  auto args = std::make_shared<ViewArgs>();
+  CLI::App* cmd = app.add_subcommand("view", "Run a scene live and watch and steer it in the browser");
+  cmd->add_option("scene", args->scene, "Scene file (TOML)")->required();
+  cmd->add_option("--set", args->overrides, "Override a scene key: KEY=VALUE (TOML value)");
+  cmd->add_option("--host", args->host, "Address to listen on (beyond 127.0.0.1 a random token guards the URL)");
+  cmd->add_option("--port", args->port, "Port (0: any free one)")->check(CLI::Range(0u, 65535u));
+  cmd->add_option("--threads", args->threads, "Worker threads of the simulation (0: all cores)")->check(CLI::NonNegativeNumber);
+  cmd->add_option("--fps", args->fps, "Frames per second sent at most")->check(CLI::Range(0.1, 240.0));
+  cmd->add_flag("--paused", args->paused, "Start paused");
+  cmd->add_option("--seconds", args->seconds, "End the session after this many wall-clock seconds (0: at Ctrl-C)")
+      ->check(CLI::NonNegativeNumber);
+  commands.push_back({cmd, [args] { return view(*args); }});
+}
+
+}  // namespace swirl::cli

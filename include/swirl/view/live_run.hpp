@@ -1,0 +1,51 @@
+// view_scene(): a scene run live for the browser (`swirl view SCENE`).
+//
+// Three threads: the simulation steps as fast as it can (or at the page's
+// speed) on the run's worker threads; an encoder turns the newest copied
+// state into a frame (view/wire.hpp) off the simulation's path; the server
+// (view/live_server.hpp) sends it. The simulation copies positions and the
+// coloured field only when the encoder is idle and a frame is due (fps), so a
+// viewer costs it one copy per frame and never a wait.
+//
+// Controls from the page act between steps: pause, resume, one step, reset
+// (the scene built again from its start), a speed cap, the field that colours
+// the particles, and the mouse's push: an external force (PushForce, a solver
+// like any other) a = strength·(v_drag − v)·(1 − r/R) on the particles within
+// R of the point, which drags the fluid along with the pointer. A live run
+// writes no run folder; a blow-up pauses it with the message shown on the page
+// (reset starts over). At the scene's end time it pauses.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "swirl/scene/scene.hpp"
+#include "swirl/view/live_server.hpp"
+
+namespace swirl::view {
+
+struct ViewOptions {
+  ServerOptions server;
+  int threads = 0;        // worker threads of the simulation (0: OpenMP's default)
+  double fps = 30;        // frames per second sent at most
+  bool start_paused = false;
+  const std::atomic<bool>* stop = nullptr;  // set (by a signal, or a test) to end the session
+  std::function<void(const std::string&)> log;
+  // Called once the server listens (the CLI prints the URL; tests connect).
+  std::function<void(const LiveServer&)> on_listening;
+};
+
+struct ViewResult {
+  std::uint64_t steps = 0;    // steps taken in the session (over resets)
+  std::uint64_t resets = 0;
+  double wall_seconds = 0;
+  ServerStats server;
+};
+
+// Runs until *options.stop; throws std::runtime_error when the server cannot listen.
+ViewResult view_scene(const scene::Scene& scene, const ViewOptions& options);
+
+}  // namespace swirl::view

@@ -1,0 +1,105 @@
+// The live view's wire format (swirl view; docs/view.md): what the server
+// sends the page and what the page may send back, as binary WebSocket
+// messages, little-endian.
+//
+// Frame (server → page), one per picture, only the newest state:
+//   offset  0  u32  magic "SWVF"
+//           4  u16  version (kFrameVersion)
+//           6  u16  colour field index (into the hello's field list; 0xffff: none)
+//           8  u64  step
+//          16  f64  simulated time
+//          24  u32  particle count n
+//          28  f32  lo x, y, z   the quantisation box (the scene's box, or the
+//          40  f32  hi x, y, z   frame's bounds for open space)
+//          52  f32  colour min, max  (the field's range over this frame)
+//          60  u16[3n]  positions, x y z per particle: lo + q/65535·(hi − lo)
+//        60+6n u8[n]    colour: min + c/255·(max − min)
+// 16 bits per axis resolve a 1 m box to 15 µm, below any SPH spacing swirl
+// runs; 7 bytes a particle (35 000 particles: 245 kB a frame).
+//
+// Control (page → server): one message, its first byte the kind, then a fixed
+// payload (f32 little-endian); any other length, kind or a non-finite or
+// out-of-range value is not a control: parse_control() says why, and the
+// server drops and logs it.
+//   1 pause   2 resume   3 step (one step while paused)   4 reset (start over)
+//   5 speed   f32 steps per second at most (0: as fast as it runs)
+//   6 colour  u8 field index
+//   7 push    f32 x, y, z (a point), f32 vx, vy, vz (the drag's velocity),
+//             f32 radius (> 0), f32 strength (≥ 0, 1/s), u8 on (0 or 1)
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include "swirl/core/vec3.hpp"
+
+namespace swirl::view {
+
+inline constexpr std::uint32_t kFrameMagic = 0x46565753u;  // "SWVF" read as little-endian u32
+inline constexpr std::uint16_t kFrameVersion = 1;
+inline constexpr std::uint16_t kNoColour = 0xffff;
+inline constexpr std::size_t kFrameHeaderBytes = 60;
+
+// One picture's worth of state, gathered by the simulation thread.
+struct FrameData {
+  std::uint64_t step = 0;
+  double time = 0;
+  std::array<float, 3> lo{}, hi{};   // the quantisation box
+  std::uint16_t colour_field = kNoColour;
+  std::vector<float> x, y, z;        // positions
+  std::vector<float> colour;         // one value per particle, or empty
+};
+
+// The message for a frame (see the header).
+std::string encode_frame(const FrameData& frame);
+
+// A frame decoded back (tests, replay tools): positions and colour as the page
+// reconstructs them.
+struct DecodedFrame {
+  std::uint64_t step = 0;
+  double time = 0;
+  std::uint16_t colour_field = kNoColour;
+  std::array<float, 3> lo{}, hi{};
+  float colour_min = 0, colour_max = 0;
+  std::vector<float> x, y, z, colour;
+};
+// Throws std::invalid_argument naming what is wrong with a message that is not a frame.
+DecodedFrame decode_frame(std::span<const std::uint8_t> message);
+
+namespace control {
+struct Pause {};
+struct Resume {};
+struct Step {};
+struct Reset {};
+struct Speed {
+  float steps_per_second = 0;
+};
+struct Colour {
+  std::uint8_t field = 0;
+};
+struct Push {
+  Vec3<float> point, velocity;
+  float radius = 0, strength = 0;
+  bool on = false;
+};
+}  // namespace control
+using Control = std::variant<control::Pause, control::Resume, control::Step, control::Reset, control::Speed,
+                             control::Colour, control::Push>;
+
+// A control message, or why it is not one (kind, length or value).
+struct Parsed {
+  std::optional<Control> control;
+  std::string error;
+};
+Parsed parse_control(std::span<const std::uint8_t> message);
+
+// The control messages as the page writes them (tests, tools).
+std::string encode_control(const Control& c);
+
+}  // namespace swirl::view

@@ -1,0 +1,338 @@
+#include "swirl/view/live_run.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <variant>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "swirl/parallel/for_blocks.hpp"
+#include "swirl/sim/build.hpp"
+#include "swirl/view/push_force.hpp"
+
+namespace swirl::view {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A JSON string literal (quotes, backslashes and control characters escaped).
+std::string json_string(std::string_view s) {
+  std::string out(1, '"');
+  for (const char c : s) {
+    if (c == '"' || c == '\\') {
+      out.push_back('\\');
+      out.push_back(c);
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      out.append(fmt::format("\\u{:04x}", static_cast<unsigned char>(c)));
+    } else {
+      out.push_back(c);
+    }
+  }
+  out.push_back('"');
+  return out;
+}
+
+std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : std::string("null"); }
+
+// What can colour the particles: the speed, then every output scalar field
+// (density, pressure, potential, ...) and integer field (a kind, a time bin).
+struct Colouring {
+  std::string name;
+  enum Source { Speed, Real, Int } source = Speed;
+  std::size_t index = 0;  // into fields() (the extra fields) or int fields
+};
+
+template <class Real>
+std::vector<Colouring> colourings(const ParticleSet<Real>& p) {
+  std::vector<Colouring> out{{"speed", Colouring::Speed, 0}};
+  const auto real = p.fields();
+  for (std::size_t k = 0; k < real.size(); ++k)
+    if (real[k].components == 1 && !real[k].internal && real[k].name != "mass")
+      out.push_back({std::string(real[k].name), Colouring::Real, k});
+  const auto ints = p.int_fields();
+  for (std::size_t k = 0; k < ints.size(); ++k)
+    if (!ints[k].internal) out.push_back({std::string(ints[k].name), Colouring::Int, k});
+  return out;
+}
+
+template <class Real>
+class LiveSession {
+ public:
+  LiveSession(const scene::Scene& scene, const ViewOptions& options)
+      : scene_(scene),
+        options_(options),
+        paused_(options.start_paused),
+        server_(
+            options.server, [this](const Control& c) { receive(c); }, [this] { return hello(); },
+            options.log) {}
+
+  ViewResult run() {
+    const auto t0 = Clock::now();
+    build();
+    server_.start();
+    if (options_.on_listening) options_.on_listening(server_);
+    std::thread encoder([this] { encode_loop(); });
+    copy_frame(true);
+    while (!(options_.stop && options_.stop->load())) {
+      apply_controls();
+      const bool step_once = (paused_ && !at_end_ && pending_steps_ > 0);
+      if (step_once) --pending_steps_;
+      if ((paused_ || at_end_) && !step_once) {
+        {
+          std::unique_lock lock(control_mutex_);
+          wake_.wait_for(lock, std::chrono::milliseconds(50), [this] { return !controls_.empty(); });
+        }
+        if (recolour_.exchange(false)) copy_frame(true);
+        report(false);
+        continue;
+      }
+      if (speed_ > 0) std::this_thread::sleep_until(last_step_ + std::chrono::duration_cast<Clock::duration>(
+                                                                    std::chrono::duration<double>(1.0 / speed_)));
+      last_step_ = Clock::now();
+      step();
+      copy_frame(step_once || paused_ || at_end_);
+      report(step_once);
+    }
+    {
+      std::lock_guard lock(frame_mutex_);
+      quit_ = true;
+    }
+    frame_cv_.notify_all();
+    encoder.join();
+    server_.stop();
+    ViewResult r;
+    r.steps = steps_;
+    r.resets = resets_;
+    r.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    r.server = server_.stats();
+    return r;
+  }
+
+ private:
+  void build() {
+    sim_ = std::make_unique<Simulation<Real>>(sim::build_simulation<Real>(scene_));
+    auto push = std::make_unique<PushForce<Real>>();
+    push_ = push.get();
+    sim_->add_solver(std::move(push));
+    sim_->start();
+    fields_ = colourings(sim_->particles());
+    at_end_ = false;
+  }
+
+  void step() {
+    try {
+      sim_->step(scene_.end_time ? std::optional<double>(*scene_.end_time) : std::nullopt);
+      ++steps_;
+    } catch (const SimulationError& e) {
+      paused_ = true;
+      server_.announce(fmt::format(R"({{"type":"error","message":{}}})", json_string(e.what())));
+      if (options_.log) options_.log(fmt::format("swirl view: {} (paused; reset starts over)", e.what()));
+      return;
+    }
+    const bool ended = scene_.end_time ? sim_->time() >= *scene_.end_time * (1 - 1e-12)
+                                       : scene_.steps && sim_->step_count() >= *scene_.steps;
+    if (ended) {
+      at_end_ = true;
+      server_.announce(status());
+    }
+  }
+
+  // A status message every half second, and at once after a single step (the page shows it).
+  void report(bool now) {
+    if (!now && Clock::now() - last_status_ < std::chrono::milliseconds(500)) return;
+    server_.announce(status());
+    last_status_ = Clock::now();
+  }
+
+  // Applies the controls received since the last call (single steps are
+  // counted in pending_steps_ and taken one per loop, each with its frame).
+  void apply_controls() {
+    std::deque<Control> todo;
+    {
+      std::lock_guard lock(control_mutex_);
+      todo.swap(controls_);
+    }
+    for (const Control& c : todo) {
+      if (std::holds_alternative<control::Pause>(c)) paused_ = true;
+      else if (std::holds_alternative<control::Resume>(c)) paused_ = false, pending_steps_ = 0;
+      else if (std::holds_alternative<control::Step>(c)) pending_steps_ += paused_ ? 1 : 0;
+      else if (std::holds_alternative<control::Reset>(c)) {
+        build();
+        ++resets_;
+        pending_steps_ = 0;
+        copy_frame(true);
+        server_.announce(status());
+      } else if (const auto* s = std::get_if<control::Speed>(&c)) {
+        speed_ = s->steps_per_second;
+      } else if (const auto* k = std::get_if<control::Colour>(&c)) {
+        if (k->field < fields_.size()) colour_ = k->field, recolour_ = true;
+      }
+    }
+  }
+
+  // On the server's thread: a push goes straight to the force; the rest waits for the next step boundary.
+  void receive(const Control& c) {
+    if (const auto* p = std::get_if<control::Push>(&c)) {
+      if (push_) push_->set(*p);
+      return;
+    }
+    {
+      std::lock_guard lock(control_mutex_);
+      controls_.push_back(c);
+    }
+    wake_.notify_all();
+  }
+
+  std::string hello() {
+    std::string fields;
+    for (const auto& f : fields_) {
+      if (!fields.empty()) fields += ',';
+      fields += json_string(f.name);
+    }
+    std::string box = "null";
+    if (scene_.walls)
+      box = fmt::format("[{},{},{},{},{},{}]", scene_.box.lo.x, scene_.box.lo.y, scene_.box.lo.z, scene_.box.hi.x,
+                        scene_.box.hi.y, scene_.box.hi.z);
+    return fmt::format(R"({{"type":"hello","scene":{},"particles":{},"fields":[{}],"colour":{},"box":{},"gravity":{},"sph":{},"paused":{}}})",
+                       json_string(scene_.file), sim_ ? sim_->particles().size() : 0, fields, colour_, box,
+                       scene_.nbody ? "true" : "false", scene_.sph ? "true" : "false", paused_ ? "true" : "false");
+  }
+
+  std::string status() {
+    const auto now = Clock::now();
+    const double dt = std::chrono::duration<double>(now - status_clock_).count();
+    const double rate = dt > 0 ? double(steps_ - status_steps_) / dt : 0;
+    status_clock_ = now, status_steps_ = steps_;
+    const auto& p = sim_->particles();
+    double kinetic = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double vx = p.velocity.x[i], vy = p.velocity.y[i], vz = p.velocity.z[i];
+      kinetic += 0.5 * double(p.mass[i]) * (vx * vx + vy * vy + vz * vz);
+    }
+    double potential = 0;
+    for (const auto& s : sim_->solvers()) potential += s->potential_energy(p, sim_->settings().block_size);
+    return fmt::format(
+        R"({{"type":"status","step":{},"time":{},"steps_per_second":{},"paused":{},"at_end":{},"kinetic_energy":{},"potential_energy":{}}})",
+        sim_->step_count(), json_number(sim_->time()), json_number(rate), paused_ ? "true" : "false",
+        at_end_ ? "true" : "false", json_number(kinetic), json_number(potential));
+  }
+
+  // Copies the state for the encoder when it is idle and a frame is due (or forced).
+  void copy_frame(bool force) {
+    const auto now = Clock::now();
+    {
+      std::lock_guard lock(frame_mutex_);
+      if (encoder_busy_) {
+        if (force) missed_ = true;
+        return;
+      }
+      if (!force && now - last_frame_ < std::chrono::duration<double>(1.0 / options_.fps)) return;
+    }
+    const auto& p = sim_->particles();
+    const std::size_t n = p.size();
+    FrameData f;
+    f.step = sim_->step_count();
+    f.time = sim_->time();
+    f.x.resize(n), f.y.resize(n), f.z.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      f.x[i] = float(p.position.x[i]), f.y[i] = float(p.position.y[i]), f.z[i] = float(p.position.z[i]);
+    if (scene_.walls) {
+      f.lo = {float(scene_.box.lo.x), float(scene_.box.lo.y), float(scene_.box.lo.z)};
+      f.hi = {float(scene_.box.hi.x), float(scene_.box.hi.y), float(scene_.box.hi.z)};
+    } else {  // open space: this frame's bounds, finite positions only
+      f.lo = {INFINITY, INFINITY, INFINITY}, f.hi = {-INFINITY, -INFINITY, -INFINITY};
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t a = 0; a < 3; ++a) {
+          const float v = a == 0 ? f.x[i] : a == 1 ? f.y[i] : f.z[i];
+          if (std::isfinite(v)) f.lo[a] = std::min(f.lo[a], v), f.hi[a] = std::max(f.hi[a], v);
+        }
+      for (std::size_t a = 0; a < 3; ++a)
+        if (!(f.lo[a] <= f.hi[a])) f.lo[a] = -1, f.hi[a] = 1;
+    }
+    const Colouring& c = fields_.at(std::min<std::size_t>(colour_, fields_.size() - 1));
+    f.colour_field = std::uint16_t(colour_);
+    f.colour.resize(n);
+    const auto real = p.fields();
+    for (std::size_t i = 0; i < n; ++i) {
+      switch (c.source) {
+        case Colouring::Speed:
+          f.colour[i] = float(std::sqrt(double(p.velocity.x[i]) * double(p.velocity.x[i]) +
+                                        double(p.velocity.y[i]) * double(p.velocity.y[i]) +
+                                        double(p.velocity.z[i]) * double(p.velocity.z[i])));
+          break;
+        case Colouring::Real: f.colour[i] = float(real[c.index].data[0][i]); break;
+        case Colouring::Int: f.colour[i] = float(p.int_field(c.index)[i]); break;
+      }
+    }
+    {
+      std::lock_guard lock(frame_mutex_);
+      pending_ = std::move(f);
+      encoder_busy_ = true;
+      last_frame_ = now;
+    }
+    frame_cv_.notify_all();
+  }
+
+  void encode_loop() {
+    for (;;) {
+      FrameData f;
+      {
+        std::unique_lock lock(frame_mutex_);
+        frame_cv_.wait(lock, [this] { return quit_ || pending_; });
+        if (quit_) return;
+        f = std::move(*pending_);
+        pending_.reset();
+      }
+      server_.publish(std::make_shared<const std::string>(encode_frame(f)));
+      bool again = false;
+      {
+        std::lock_guard lock(frame_mutex_);
+        encoder_busy_ = false;
+        again = std::exchange(missed_, false);
+      }
+      if (again) recolour_ = true;  // a forced frame was skipped while busy: the loop sends it
+    }
+  }
+
+  const scene::Scene& scene_;
+  const ViewOptions& options_;
+  std::unique_ptr<Simulation<Real>> sim_;
+  PushForce<Real>* push_ = nullptr;
+  std::vector<Colouring> fields_;
+  std::atomic<std::size_t> colour_{0};
+  std::atomic<bool> recolour_{false};
+  bool paused_ = false, at_end_ = false;
+  float speed_ = 0;
+  std::uint64_t steps_ = 0, resets_ = 0, status_steps_ = 0, pending_steps_ = 0;
+  Clock::time_point last_step_{}, status_clock_ = Clock::now(), last_status_{};
+
+  std::mutex control_mutex_;
+  std::condition_variable wake_;
+  std::deque<Control> controls_;
+
+  std::mutex frame_mutex_;
+  std::condition_variable frame_cv_;
+  std::optional<FrameData> pending_;
+  bool encoder_busy_ = false, quit_ = false, missed_ = false;
+  Clock::time_point last_frame_{};
+
+  LiveServer server_;
+};
+
+}  // namespace
+
+ViewResult view_scene(const scene::Scene& scene, const ViewOptions& options) {
+  if (options.threads > 0) parallel::set_thread_count(options.threads);
+  if (!(options.fps > 0)) throw std::invalid_argument("swirl view: fps must be > 0");
+  if (scene.precision == scene::Precision::Float) return LiveSession<float>(scene, options).run();
+  return LiveSession<double>(scene, options).run();
+}
+
+}  // namespace swirl::view

@@ -1,0 +1,180 @@
+#include "swirl/view/wire.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace swirl::view {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the wire format is little-endian, as is every host swirl runs on");
+
+template <class T>
+void put(std::string& out, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  out.append(bytes, sizeof(T));
+}
+
+template <class T>
+T get(std::span<const std::uint8_t> in, std::size_t offset) {
+  T value;
+  std::memcpy(&value, in.data() + offset, sizeof(T));
+  return value;
+}
+
+// q in [0, levels] for v in [lo, hi] (clamped: a particle outside the box is drawn on its face).
+std::uint32_t quantise(float v, float lo, float scale, std::uint32_t levels) {
+  const float q = std::round((v - lo) * scale);
+  if (!(q > 0)) return 0;  // also NaN
+  return q >= float(levels) ? levels : std::uint32_t(q);
+}
+
+}  // namespace
+
+std::string encode_frame(const FrameData& f) {
+  const std::size_t n = f.x.size();
+  if (f.y.size() != n || f.z.size() != n || (!f.colour.empty() && f.colour.size() != n))
+    throw std::invalid_argument("encode_frame: the arrays differ in length");
+  float cmin = 0, cmax = 0;
+  if (!f.colour.empty()) {
+    cmin = INFINITY, cmax = -INFINITY;
+    for (const float c : f.colour)
+      if (std::isfinite(c)) cmin = std::min(cmin, c), cmax = std::max(cmax, c);
+    if (!(cmin <= cmax)) cmin = cmax = 0;  // no finite value
+  }
+  std::string out;
+  out.reserve(kFrameHeaderBytes + 7 * n);
+  put(out, kFrameMagic);
+  put(out, kFrameVersion);
+  put(out, f.colour.empty() ? kNoColour : f.colour_field);
+  put(out, f.step);
+  put(out, f.time);
+  put(out, std::uint32_t(n));
+  for (const float v : f.lo) put(out, v);
+  for (const float v : f.hi) put(out, v);
+  put(out, cmin);
+  put(out, cmax);
+  const std::array<const std::vector<float>*, 3> axes{&f.x, &f.y, &f.z};
+  std::array<float, 3> scale{};
+  for (int a = 0; a < 3; ++a) {
+    const float extent = f.hi[std::size_t(a)] - f.lo[std::size_t(a)];
+    scale[std::size_t(a)] = extent > 0 ? 65535.0f / extent : 0.0f;
+  }
+  const std::size_t positions = out.size();
+  out.resize(positions + 6 * n + n);
+  auto* p = reinterpret_cast<unsigned char*>(out.data() + positions);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto q = std::uint16_t(quantise((*axes[a])[i], f.lo[a], scale[a], 65535));
+      std::memcpy(p + 6 * i + 2 * a, &q, 2);
+    }
+  unsigned char* c = p + 6 * n;
+  const float cscale = cmax > cmin ? 255.0f / (cmax - cmin) : 0.0f;
+  for (std::size_t i = 0; i < n && !f.colour.empty(); ++i) c[i] = std::uint8_t(quantise(f.colour[i], cmin, cscale, 255));
+  if (f.colour.empty()) std::fill(c, c + n, std::uint8_t(0));
+  return out;
+}
+
+DecodedFrame decode_frame(std::span<const std::uint8_t> m) {
+  if (m.size() < kFrameHeaderBytes) throw std::invalid_argument(fmt::format("frame: {} bytes, shorter than the header", m.size()));
+  if (get<std::uint32_t>(m, 0) != kFrameMagic) throw std::invalid_argument("frame: not a swirl frame (magic)");
+  if (const auto v = get<std::uint16_t>(m, 4); v != kFrameVersion)
+    throw std::invalid_argument(fmt::format("frame: version {}, this reader knows {}", v, kFrameVersion));
+  DecodedFrame f;
+  f.colour_field = get<std::uint16_t>(m, 6);
+  f.step = get<std::uint64_t>(m, 8);
+  f.time = get<double>(m, 16);
+  const std::size_t n = get<std::uint32_t>(m, 24);
+  for (std::size_t a = 0; a < 3; ++a) {
+    f.lo[a] = get<float>(m, 28 + 4 * a);
+    f.hi[a] = get<float>(m, 40 + 4 * a);
+  }
+  f.colour_min = get<float>(m, 52);
+  f.colour_max = get<float>(m, 56);
+  if (m.size() != kFrameHeaderBytes + 7 * n)
+    throw std::invalid_argument(fmt::format("frame: {} bytes for {} particles, expected {}", m.size(), n, kFrameHeaderBytes + 7 * n));
+  f.x.resize(n), f.y.resize(n), f.z.resize(n), f.colour.resize(n);
+  std::array<std::vector<float>*, 3> axes{&f.x, &f.y, &f.z};
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto q = get<std::uint16_t>(m, kFrameHeaderBytes + 6 * i + 2 * a);
+      (*axes[a])[i] = f.lo[a] + float(q) / 65535.0f * (f.hi[a] - f.lo[a]);
+    }
+    f.colour[i] = f.colour_min + float(m[kFrameHeaderBytes + 6 * n + i]) / 255.0f * (f.colour_max - f.colour_min);
+  }
+  return f;
+}
+
+namespace {
+enum Kind : std::uint8_t { kPause = 1, kResume = 2, kStep = 3, kReset = 4, kSpeed = 5, kColour = 6, kPush = 7 };
+constexpr std::size_t kPayload[] = {0, 0, 0, 0, 0, 4, 1, 33};  // bytes after the kind, by kind
+
+Parsed refuse(std::string why) { return Parsed{std::nullopt, std::move(why)}; }
+}  // namespace
+
+Parsed parse_control(std::span<const std::uint8_t> m) {
+  if (m.empty()) return refuse("an empty message");
+  const std::uint8_t kind = m[0];
+  if (kind < kPause || kind > kPush) return refuse(fmt::format("unknown control kind {}", kind));
+  if (m.size() != 1 + kPayload[kind])
+    return refuse(fmt::format("control kind {} has {} bytes, expected {}", kind, m.size(), 1 + kPayload[kind]));
+  auto f32 = [&](std::size_t k) { return get<float>(m, 1 + 4 * k); };
+  switch (kind) {
+    case kPause: return {control::Pause{}, {}};
+    case kResume: return {control::Resume{}, {}};
+    case kStep: return {control::Step{}, {}};
+    case kReset: return {control::Reset{}, {}};
+    case kSpeed: {
+      const float s = f32(0);
+      if (!std::isfinite(s) || s < 0) return refuse(fmt::format("speed {}: must be finite and >= 0", s));
+      return {control::Speed{s}, {}};
+    }
+    case kColour: return {control::Colour{m[1]}, {}};
+    default: {
+      control::Push p;
+      for (int k = 0; k < 8; ++k)
+        if (!std::isfinite(f32(std::size_t(k)))) return refuse("push: a value is not finite");
+      p.point = {f32(0), f32(1), f32(2)};
+      p.velocity = {f32(3), f32(4), f32(5)};
+      p.radius = f32(6);
+      p.strength = f32(7);
+      if (!(p.radius > 0) || p.strength < 0) return refuse("push: radius must be > 0 and strength >= 0");
+      if (m[33] > 1) return refuse("push: 'on' must be 0 or 1");
+      p.on = m[33] == 1;
+      return {p, {}};
+    }
+  }
+}
+
+std::string encode_control(const Control& c) {
+  std::string out;
+  std::visit(
+      [&](const auto& v) {
+        using T = std::decay_t<decltype(v)>;
+        if constexpr (std::is_same_v<T, control::Pause>) out.push_back(char(kPause));
+        else if constexpr (std::is_same_v<T, control::Resume>) out.push_back(char(kResume));
+        else if constexpr (std::is_same_v<T, control::Step>) out.push_back(char(kStep));
+        else if constexpr (std::is_same_v<T, control::Reset>) out.push_back(char(kReset));
+        else if constexpr (std::is_same_v<T, control::Speed>) {
+          out.push_back(char(kSpeed));
+          put(out, v.steps_per_second);
+        } else if constexpr (std::is_same_v<T, control::Colour>) {
+          out.push_back(char(kColour));
+          out.push_back(char(v.field));
+        } else {
+          out.push_back(char(kPush));
+          for (const float x : {v.point.x, v.point.y, v.point.z, v.velocity.x, v.velocity.y, v.velocity.z, v.radius, v.strength})
+            put(out, x);
+          out.push_back(char(v.on ? 1 : 0));
+        }
+      },
+      c);
+  return out;
+}
+
+}  // namespace swirl::view

@@ -1,0 +1,234 @@
+// A live session (view/live_run.hpp) driven by WebSocket clients of our own
+// (Boost.Beast): the hello and the frames a page receives, pause / step /
+// resume, the mouse's push moving the fluid, and hostile messages — unknown
+// kinds, bad values, an oversized message — dropped without stopping the run
+// or the other viewers.
+#include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include <boost/asio.hpp>
+#include <boost/beast.hpp>
+#include <boost/beast/websocket.hpp>
+
+#include "swirl/scene/load.hpp"
+#include "swirl/view/live_run.hpp"
+#include "swirl/view/push_force.hpp"
+
+namespace swirl::view {
+namespace {
+
+namespace beast = boost::beast;
+namespace websocket = beast::websocket;
+namespace net = boost::asio;
+using tcp = net::ip::tcp;
+using namespace std::chrono_literals;
+
+// A viewer: one WebSocket, each read with a deadline (a test fails, never hangs).
+class Viewer {
+ public:
+  explicit Viewer(std::uint16_t port) : ws_(ioc_) {
+    tcp::resolver resolver(ioc_);
+    beast::get_lowest_layer(ws_).connect(resolver.resolve("127.0.0.1", std::to_string(port)));
+    ws_.handshake("127.0.0.1", "/ws");
+  }
+  // The next message: text (first) and its bytes; throws after 20 s.
+  std::pair<bool, std::string> next() {
+    beast::flat_buffer buffer;
+    beast::error_code result = net::error::timed_out;
+    bool done = false;
+    ws_.async_read(buffer, [&](beast::error_code ec, std::size_t) { result = ec, done = true; });
+    ioc_.restart();
+    ioc_.run_for(20s);
+    if (!done) {
+      beast::get_lowest_layer(ws_).cancel();
+      ioc_.restart();
+      ioc_.run();
+      throw std::runtime_error("no message from the server within 20 s");
+    }
+    if (result) throw beast::system_error(result);
+    return {ws_.got_text(), beast::buffers_to_string(buffer.data())};
+  }
+  // The next frame, skipping text messages.
+  DecodedFrame frame() {
+    for (;;) {
+      auto [text, data] = next();
+      if (!text) return decode_frame({reinterpret_cast<const std::uint8_t*>(data.data()), data.size()});
+    }
+  }
+  // The next status message's text.
+  std::string status() {
+    for (;;) {
+      auto [text, data] = next();
+      if (text && data.find("\"status\"") != std::string::npos) return data;
+    }
+  }
+  void send(const std::string& bytes, bool text = false) {
+    ws_.text(text);
+    ws_.write(net::buffer(bytes));
+  }
+  // Reads until the server closes the session (true) or 20 s pass (false).
+  bool closed_by_server() {
+    try {
+      for (;;) next();
+    } catch (const beast::system_error&) {
+      return true;
+    } catch (const std::runtime_error&) {
+      return false;
+    }
+  }
+
+ private:
+  net::io_context ioc_;
+  websocket::stream<beast::tcp_stream> ws_;
+};
+
+std::uint64_t field_u64(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\":");
+  return at == std::string::npos ? 0 : std::stoull(json.substr(at + key.size() + 3));
+}
+
+class LiveSession : public ::testing::Test {
+ protected:
+  void start(bool paused = false) {
+    const std::string file = std::string(SWIRL_SOURCE_DIR) + "/examples/dam_break.toml";
+    // The column fills the box's y exactly (16 layers of 0.03): symmetric across y = 0.24.
+    const std::vector<std::string> overrides{"particles.0.spacing=0.03", "simulation.end_time=100",
+                                             "box.max=[1.0, 0.48, 0.6]", "particles.0.max=[0.3, 0.48, 0.4]"};
+    scene_ = scene::load_scene(file, overrides);
+    options_.server.port = 0;
+    options_.fps = 60;
+    options_.threads = 1;
+    options_.start_paused = paused;
+    options_.stop = &stop_;
+    options_.log = [](const std::string&) {};
+    std::promise<std::uint16_t> listening;
+    auto port = listening.get_future();
+    options_.on_listening = [&listening](const LiveServer& s) { listening.set_value(s.port()); };
+    run_ = std::async(std::launch::async, [this] { return view_scene(scene_, options_); });
+    port_ = port.get();
+  }
+  ViewResult finish() {
+    stop_ = true;
+    return run_.get();
+  }
+  void TearDown() override {
+    if (run_.valid()) finish();
+  }
+
+  scene::Scene scene_;
+  ViewOptions options_;
+  std::atomic<bool> stop_{false};
+  std::future<ViewResult> run_;
+  std::uint16_t port_ = 0;
+};
+
+TEST_F(LiveSession, AViewerGetsTheHelloAndFramesOfTheRunningScene) {
+  start();
+  Viewer v(port_);
+  auto [text, hello] = v.next();
+  ASSERT_TRUE(text);
+  EXPECT_NE(hello.find("\"type\":\"hello\""), std::string::npos) << hello;
+  EXPECT_NE(hello.find("\"speed\""), std::string::npos) << hello;
+  EXPECT_NE(hello.find("\"box\":[0,0,0,1,0.48,0.6]"), std::string::npos) << hello;
+  const DecodedFrame a = v.frame();
+  const std::uint64_t n = field_u64(hello, "particles");
+  ASSERT_GT(n, 100u);
+  EXPECT_EQ(a.x.size(), n);
+  DecodedFrame b = v.frame();
+  for (int k = 0; k < 100 && b.step <= a.step; ++k) b = v.frame();  // the run goes on: newer states arrive
+  EXPECT_GT(b.step, a.step);
+  const ViewResult r = finish();
+  EXPECT_GT(r.steps, 0u);
+  EXPECT_GE(r.server.frames_sent, 2u);
+}
+
+TEST_F(LiveSession, PauseStepAndResumeActBetweenSteps) {
+  start(/*paused=*/true);
+  Viewer v(port_);
+  const std::uint64_t s0 = field_u64(v.status(), "step");
+  EXPECT_EQ(field_u64(v.status(), "step"), s0) << "paused: no steps";
+  v.send(encode_control(control::Step{}));
+  std::string st = v.status();
+  EXPECT_EQ(field_u64(st, "step"), s0 + 1) << st;
+  EXPECT_NE(st.find("\"paused\":true"), std::string::npos) << st;
+  v.send(encode_control(control::Resume{}));
+  std::uint64_t s = s0 + 1;
+  for (int k = 0; k < 5 && s <= s0 + 1; ++k) s = field_u64(v.status(), "step");
+  EXPECT_GT(s, s0 + 1);
+}
+
+TEST_F(LiveSession, HostileMessagesAreDroppedAndTheRunAndOtherViewersGoOn) {
+  start();
+  Viewer good(port_), bad(port_);
+  bad.send(std::string(1, char(99)));                          // unknown kind
+  bad.send(std::string(40, char(7)));                          // wrong length
+  std::string nan_push = encode_control(control::Push{{0, 0, 0}, {0, 0, 0}, 1, 1, true});
+  nan_push[1] = nan_push[2] = nan_push[3] = char(0xff), nan_push[4] = char(0x7f);  // x = NaN
+  bad.send(nan_push);
+  bad.send("{\"type\":\"pwn\"}", /*text=*/true);  // text is no control either
+  bad.send(std::string(1, char(2)));  // a valid resume after them: the session is still open
+  bad.send(std::string(5000, 'x'));   // over the 1024-byte limit: this session ends
+  EXPECT_TRUE(bad.closed_by_server()) << "the oversized message should close the session";
+  const std::uint64_t before = good.frame().step;
+  std::uint64_t after = before;
+  for (int k = 0; k < 100 && after <= before; ++k) after = good.frame().step;
+  EXPECT_GT(after, before) << "the other viewer still receives a running simulation";
+  const ViewResult r = finish();
+  EXPECT_GE(r.server.dropped, 5u);
+  EXPECT_GE(r.server.controls, 1u);
+}
+
+// The push drags the particles under it with the pointer's velocity. The dam
+// break is symmetric across y (the column fills the box's width, the flow
+// along x and z), so without a push the particles' mean y stays put; a push along +y at
+// the top of the column moves it.
+float mean_y(const DecodedFrame& f) {
+  double sum = 0;
+  for (const float y : f.y) sum += y;
+  return float(sum / double(f.y.size()));
+}
+
+TEST_F(LiveSession, TheMousePushMovesTheFluid) {
+  start(/*paused=*/true);
+  Viewer v(port_);
+  const DecodedFrame before = v.frame();
+  float top = 0;
+  for (std::size_t i = 0; i < before.z.size(); ++i) top = std::max(top, before.z[i]);
+  const float y0 = mean_y(before);
+  v.send(encode_control(control::Push{{0.15f, 0.24f, top}, {0, 3, 0}, 0.12f, 100, true}));
+  constexpr int kSteps = 100;  // 0.04 s
+  for (int k = 0; k < kSteps; ++k) v.send(encode_control(control::Step{}));
+  DecodedFrame after = v.frame();
+  for (int k = 0; k < 10 * kSteps && after.step < before.step + kSteps; ++k) after = v.frame();  // the last step's state
+  ASSERT_EQ(after.step, before.step + kSteps);
+  // Measured: +3.0 mm with the push; without it (on = false) 0.00 mm.
+  EXPECT_GT(mean_y(after) - y0, 0.0005f) << "the push along +y should move the fluid's mean y";
+}
+
+TEST(PushForce, RelaxesVelocitiesTowardTheDragWithinItsRadiusOnly) {
+  ParticleSet<double> p(3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    p.position.set(i, Vec3<double>{double(i) * 0.6, 0, 0});
+    p.mass[i] = 1;
+  }
+  PushForce<double> push;
+  push.set(control::Push{{0, 0, 0}, {1, 0, 0}, 1.0f, 10, true});
+  push.add_acceleration(p, SolverContext<double>{0, 1, nullptr, nullptr, {}});
+  EXPECT_DOUBLE_EQ(p.acceleration.x[0], 10.0);            // at the point: s·(u − v)
+  EXPECT_NEAR(p.acceleration.x[1], 10.0 * 0.4, 1e-6);     // 0.6 R away: (1 − 0.6)
+  EXPECT_EQ(p.acceleration.x[2], 0.0);                    // outside R
+  push.set(control::Push{{0, 0, 0}, {1, 0, 0}, 1.0f, 10, false});
+  push.add_acceleration(p, SolverContext<double>{0, 1, nullptr, nullptr, {}});
+  EXPECT_DOUBLE_EQ(p.acceleration.x[0], 10.0);  // off: nothing added
+}
+
+}  // namespace
+}  // namespace swirl::view

@@ -1,0 +1,241 @@
+// swirl view's page: decodes the server's frames (src/view/wire.cpp has the
+// layout), draws the particles as lit spheres (WebGL2 point-sprite impostors)
+// and sends the controls back. Written for swirl; no libraries.
+"use strict";
+
+const token = new URLSearchParams(location.search).get("token");
+const canvas = document.getElementById("view");
+const gl = canvas.getContext("webgl2", { antialias: false, preserveDrawingBuffer: true });
+const ui = (id) => document.getElementById(id);
+
+// ---- State -------------------------------------------------------------------
+const state = {
+  hello: null, frame: null, count: 0, lo: [0, 0, 0], hi: [1, 1, 1],
+  yaw: 0.6, pitch: 0.35, distance: 3, target: [0, 0, 0], framed: false,
+  paused: false, status: null, history: [], frames: 0, lastDraw: performance.now(), fps: 0,
+};
+window.swirlView = state;  // for tests and the console
+
+// ---- Maths -------------------------------------------------------------------
+function perspective(fovy, aspect, near, far) {
+  const f = 1 / Math.tan(fovy / 2), nf = 1 / (near - far);
+  return [f / aspect, 0, 0, 0, 0, f, 0, 0, 0, 0, (far + near) * nf, -1, 0, 0, 2 * far * near * nf, 0];
+}
+function sub(a, b) { return [a[0] - b[0], a[1] - b[1], a[2] - b[2]]; }
+function cross(a, b) { return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]; }
+function normalise(a) { const l = Math.hypot(a[0], a[1], a[2]) || 1; return [a[0] / l, a[1] / l, a[2] / l]; }
+function dot(a, b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+function eye() {
+  const c = Math.cos(state.pitch), t = state.target, d = state.distance;
+  return [t[0] + d * c * Math.cos(state.yaw), t[1] + d * c * Math.sin(state.yaw), t[2] + d * Math.sin(state.pitch)];
+}
+function basis() {  // camera axes: right, up, forward (z is up in swirl's scenes)
+  const f = normalise(sub(state.target, eye()));
+  const r = normalise(cross(f, [0, 0, 1]));
+  return { r, u: cross(r, f), f };
+}
+function lookAt() {
+  const e = eye(), { r, u, f } = basis();
+  return [r[0], u[0], -f[0], 0, r[1], u[1], -f[1], 0, r[2], u[2], -f[2], 0, -dot(r, e), -dot(u, e), dot(f, e), 1];
+}
+
+// ---- Drawing -----------------------------------------------------------------
+const vs = `#version 300 es
+in vec3 q; in float c;
+uniform mat4 view, proj; uniform vec3 lo, span; uniform float radius, height;
+out float colour;
+void main() {
+  vec3 p = lo + q / 65535.0 * span;
+  vec4 v = view * vec4(p, 1.0);
+  gl_Position = proj * v;
+  gl_PointSize = max(1.5, height * proj[1][1] * radius / -v.z);
+  colour = c / 255.0;
+}`;
+const fs = `#version 300 es
+precision mediump float;
+in float colour; uniform int additive; out vec4 outColor;
+vec3 ramp(float t) {  // dark blue - cyan - yellow - red
+  return clamp(vec3(1.5 * t - 0.2, 1.6 * t * (1.3 - t) + 0.15, 1.0 - 1.4 * t + 0.3), 0.0, 1.0);
+}
+void main() {
+  vec2 d = gl_PointCoord * 2.0 - 1.0; float r2 = dot(d, d);
+  if (r2 > 1.0) discard;
+  vec3 n = vec3(d.x, -d.y, sqrt(1.0 - r2));
+  float light = 0.35 + 0.65 * max(dot(n, normalize(vec3(0.4, 0.5, 0.8))), 0.0);
+  if (additive == 1) outColor = vec4(ramp(colour) * 0.18 * (1.0 - r2), 1.0);
+  else outColor = vec4(ramp(colour) * light, 1.0);
+}`;
+function compile(type, src) {
+  const s = gl.createShader(type); gl.shaderSource(s, src); gl.compileShader(s);
+  if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s));
+  return s;
+}
+const program = gl.createProgram();
+gl.attachShader(program, compile(gl.VERTEX_SHADER, vs));
+gl.attachShader(program, compile(gl.FRAGMENT_SHADER, fs));
+gl.bindAttribLocation(program, 0, "q"); gl.bindAttribLocation(program, 1, "c");
+gl.linkProgram(program);
+const uni = {};
+for (const n of ["view", "proj", "lo", "span", "radius", "height", "additive"]) uni[n] = gl.getUniformLocation(program, n);
+const vao = gl.createVertexArray(), qbuf = gl.createBuffer(), cbuf = gl.createBuffer();
+gl.bindVertexArray(vao);
+gl.bindBuffer(gl.ARRAY_BUFFER, qbuf); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 3, gl.UNSIGNED_SHORT, false, 0, 0);
+gl.bindBuffer(gl.ARRAY_BUFFER, cbuf); gl.enableVertexAttribArray(1); gl.vertexAttribPointer(1, 1, gl.UNSIGNED_BYTE, false, 0, 0);
+
+function draw() {
+  const w = canvas.clientWidth, h = canvas.clientHeight;
+  if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
+  gl.viewport(0, 0, w, h);
+  gl.clearColor(0.06, 0.08, 0.1, 1); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
+  if (state.count > 0) {
+    const gravity = state.hello && state.hello.gravity && !state.hello.sph;
+    gl.useProgram(program);
+    gl.uniformMatrix4fv(uni.view, false, lookAt());
+    gl.uniformMatrix4fv(uni.proj, false, perspective(0.8, w / h, state.distance * 0.01, state.distance * 100));
+    gl.uniform3fv(uni.lo, state.lo);
+    gl.uniform3fv(uni.span, sub(state.hi, state.lo));
+    gl.uniform1f(uni.radius, particleRadius());
+    gl.uniform1f(uni.height, h / 2);
+    gl.uniform1i(uni.additive, gravity ? 1 : 0);
+    if (gravity) { gl.disable(gl.DEPTH_TEST); gl.enable(gl.BLEND); gl.blendFunc(gl.ONE, gl.ONE); }
+    else { gl.enable(gl.DEPTH_TEST); gl.disable(gl.BLEND); }
+    gl.bindVertexArray(vao);
+    gl.drawArrays(gl.POINTS, 0, state.count);
+  }
+  const now = performance.now();
+  state.fps = 0.9 * state.fps + 0.1 * (1000 / Math.max(1, now - state.lastDraw));
+  state.lastDraw = now;
+  state.frames++;
+  requestAnimationFrame(draw);
+}
+function particleRadius() {  // half the mean spacing of the particles in their bounds
+  const s = sub(state.hi, state.lo), vol = Math.max(s[0] * s[1] * s[2], 1e-30);
+  return 0.5 * Math.cbrt(vol / Math.max(state.count, 1));
+}
+
+// ---- Frames and messages -------------------------------------------------------
+function onFrame(buffer) {
+  const dv = new DataView(buffer);
+  if (buffer.byteLength < 60 || dv.getUint32(0, true) !== 0x46565753) return;
+  const n = dv.getUint32(24, true);
+  if (buffer.byteLength !== 60 + 7 * n) return;
+  state.count = n;
+  state.step = Number(dv.getBigUint64(8, true));
+  state.time = dv.getFloat64(16, true);
+  for (let a = 0; a < 3; a++) { state.lo[a] = dv.getFloat32(28 + 4 * a, true); state.hi[a] = dv.getFloat32(40 + 4 * a, true); }
+  state.colourRange = [dv.getFloat32(52, true), dv.getFloat32(56, true)];
+  gl.bindBuffer(gl.ARRAY_BUFFER, qbuf); gl.bufferData(gl.ARRAY_BUFFER, new Uint16Array(buffer, 60, 3 * n), gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ARRAY_BUFFER, cbuf); gl.bufferData(gl.ARRAY_BUFFER, new Uint8Array(buffer, 60 + 6 * n, n), gl.DYNAMIC_DRAW);
+  if (!state.framed) frameCamera();
+  state.received = (state.received || 0) + 1;
+  ui("barlo").textContent = state.colourRange[0].toPrecision(3);
+  ui("barhi").textContent = state.colourRange[1].toPrecision(3);
+}
+function frameCamera() {
+  const b = state.hello && state.hello.box;
+  const lo = b ? b.slice(0, 3) : state.lo, hi = b ? b.slice(3) : state.hi;
+  state.target = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2];
+  state.distance = 1.8 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]);
+  state.framed = true;
+}
+function onText(text) {
+  const m = JSON.parse(text);
+  if (m.type === "hello") {
+    state.hello = m;
+    ui("scene").textContent = m.scene + " · " + m.particles + " particles";
+    const sel = ui("colour"); sel.innerHTML = "";
+    m.fields.forEach((f, i) => { const o = document.createElement("option"); o.value = i; o.textContent = f; sel.appendChild(o); });
+    sel.value = m.colour;
+    setPaused(m.paused);
+  } else if (m.type === "status") {
+    state.status = m;
+    setPaused(m.paused || m.at_end);
+    state.history.push({ e: m.kinetic_energy + m.potential_energy, rate: m.steps_per_second });
+    if (state.history.length > 240) state.history.shift();
+    ui("stats").textContent = `step ${m.step} · t = ${Number(m.time).toPrecision(4)} · ${m.steps_per_second.toFixed(1)} steps/s · ` +
+      `${state.fps.toFixed(0)} fps` + (m.at_end ? " · end of run" : "");
+    plot();
+  } else if (m.type === "error") {
+    const box = ui("message"); box.textContent = m.message; box.style.display = "block";
+  }
+}
+function plot() {
+  const c = ui("plot"), g = c.getContext("2d"); g.clearRect(0, 0, c.width, c.height);
+  const h = state.history; if (h.length < 2) return;
+  const line = (key, colour, y0, y1) => {
+    const vs = h.map((x) => x[key]).filter(Number.isFinite); if (!vs.length) return;
+    const lo = Math.min(...vs), hi = Math.max(...vs), span = hi - lo || 1;
+    g.strokeStyle = colour; g.beginPath();
+    h.forEach((x, i) => { const px = (i / (h.length - 1)) * c.width, py = y1 - ((x[key] - lo) / span) * (y1 - y0); i ? g.lineTo(px, py) : g.moveTo(px, py); });
+    g.stroke();
+  };
+  g.fillStyle = "#889"; g.fillText("energy", 4, 12); g.fillText("steps/s", 4, 66);
+  line("e", "#6cf", 14, 52); line("rate", "#fc6", 68, 106);
+}
+
+// ---- Controls back ---------------------------------------------------------------
+let socket = null;
+function send(bytes) { if (socket && socket.readyState === 1) socket.send(bytes); }
+function sendKind(k) { send(new Uint8Array([k])); }
+function sendSpeed(s) { const b = new DataView(new ArrayBuffer(5)); b.setUint8(0, 5); b.setFloat32(1, s, true); send(b.buffer); }
+function sendColour(i) { send(new Uint8Array([6, i])); }
+function sendPush(point, velocity, on) {
+  const b = new DataView(new ArrayBuffer(34)); b.setUint8(0, 7);
+  const r = 10 * particleRadius(), values = [...point, ...velocity, r, 40];
+  values.forEach((v, i) => b.setFloat32(1 + 4 * i, v, true));
+  b.setUint8(33, on ? 1 : 0); send(b.buffer);
+}
+function setPaused(p) { state.paused = p; ui("play").textContent = p ? "play" : "pause"; }
+ui("play").onclick = () => { sendKind(state.paused ? 2 : 1); setPaused(!state.paused); };
+ui("step").onclick = () => sendKind(3);
+ui("reset").onclick = () => { sendKind(4); ui("message").style.display = "none"; };
+ui("speed").onchange = (e) => sendSpeed(Number(e.target.value));
+ui("colour").onchange = (e) => sendColour(Number(e.target.value));
+
+// ---- Mouse: orbit, pan, zoom, push -----------------------------------------------------
+let drag = null;
+function worldAt(x, y) {  // the point under the pointer on the plane through the target facing the camera
+  const w = canvas.clientWidth, h = canvas.clientHeight, t = Math.tan(0.4);
+  const { r, u, f } = basis(), e = eye();
+  const dir = normalise([0, 1, 2].map((a) => f[a] + r[a] * ((2 * x / w - 1) * t * w / h) + u[a] * ((1 - 2 * y / h) * t)));
+  const s = dot(sub(state.target, e), f) / dot(dir, f);
+  return [e[0] + s * dir[0], e[1] + s * dir[1], e[2] + s * dir[2]];
+}
+canvas.addEventListener("pointerdown", (ev) => {
+  canvas.setPointerCapture(ev.pointerId);
+  drag = { x: ev.clientX, y: ev.clientY, pan: ev.shiftKey, push: ui("push").checked, t: performance.now(), p: worldAt(ev.clientX, ev.clientY) };
+  if (drag.push) sendPush(drag.p, [0, 0, 0], true);
+});
+canvas.addEventListener("pointermove", (ev) => {
+  if (!drag) return;
+  const dx = ev.clientX - drag.x, dy = ev.clientY - drag.y;
+  if (drag.push) {
+    const now = performance.now(), p = worldAt(ev.clientX, ev.clientY), dt = Math.max((now - drag.t) / 1000, 1e-3);
+    sendPush(p, sub(p, drag.p).map((v) => v / dt), true);
+    drag.p = p; drag.t = now;
+  } else if (drag.pan) {
+    const { r, u } = basis(), k = state.distance * 0.0015;
+    state.target = [0, 1, 2].map((a) => state.target[a] - r[a] * dx * k + u[a] * dy * k);
+  } else {
+    state.yaw -= dx * 0.006; state.pitch = Math.max(-1.5, Math.min(1.5, state.pitch + dy * 0.006));
+  }
+  drag.x = ev.clientX; drag.y = ev.clientY;
+});
+canvas.addEventListener("pointerup", () => { if (drag && drag.push) sendPush(drag.p, [0, 0, 0], false); drag = null; });
+canvas.addEventListener("wheel", (ev) => { ev.preventDefault(); state.distance *= Math.exp(ev.deltaY * 0.001); }, { passive: false });
+
+// The colour bar.
+(() => { const g = ui("bar").getContext("2d");
+  for (let i = 0; i < 200; i++) { const t = 1 - i / 199;
+    const r = Math.min(1, Math.max(0, 1.5 * t - 0.2)), gg = Math.min(1, Math.max(0, 1.6 * t * (1.3 - t) + 0.15)), b = Math.min(1, Math.max(0, 1 - 1.4 * t + 0.3));
+    g.fillStyle = `rgb(${255 * r | 0},${255 * gg | 0},${255 * b | 0})`; g.fillRect(0, i, 16, 1); } })();
+
+// ---- Connection ----------------------------------------------------------------------
+function connect() {
+  const url = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws` + (token ? `?token=${encodeURIComponent(token)}` : "");
+  socket = new WebSocket(url); socket.binaryType = "arraybuffer";
+  socket.onmessage = (ev) => (typeof ev.data === "string" ? onText(ev.data) : onFrame(ev.data));
+  socket.onclose = () => { ui("stats").textContent = "disconnected: the run has ended (reload to reconnect)"; };
+}
+connect();
+requestAnimationFrame(draw);
