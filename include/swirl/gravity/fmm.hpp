@@ -43,7 +43,11 @@
 //               else interact(children of the larger-radius non-leaf, other).
 // Every interaction is mutual: one M2L computes D(z_A − z_B) once and fills
 // both C(A) (with M(B)) and C(B) (with M(A), D(z_B − z_A) = (−1)^{|m|} D(z_A − z_B));
-// one P2P pair term is added to both particles with opposite signs. So the
+// one P2P pair term between two cells is added to both particles with opposite
+// signs (within a cell each particle sums over all the others, every pair
+// twice, the two terms exact negations: x_i − x_j = −(x_j − x_i) in IEEE
+// arithmetic, so R and 1/R³ are the same bits; this lets the loop run whole
+// SIMD vectors). So the
 // total force Σ m_i a_i is zero in exact arithmetic: for the far field
 //   F_A = Σ_{|k|+|n| ≤ p} M_k(A) (−1)^{|n|} M_n(B) D_{k+n+e}(R) = −F_B
 // (swap k and n; L2L and L2P only move and evaluate the same polynomial), and
@@ -91,7 +95,7 @@ void validate(const FmmSettings& settings);
 struct FmmStats {
   std::uint64_t m2l = 0;          // cell–cell expansion interactions (each mutual: counts once)
   std::uint64_t p2p_cells = 0;    // P2P cell pairs and cell self-interactions
-  std::uint64_t p2p_pairs = 0;    // particle pairs evaluated (each mutual: counts once)
+  std::uint64_t p2p_pairs = 0;    // particle pairs interacting directly (each counts once)
   std::size_t tasks = 0;          // walk tasks
   std::size_t nodes = 0, leaves = 0;
   int depth = 0;
