@@ -217,49 +217,6 @@ inline void powers(double x, double y, double z, double* T) {
     T[s] = T[steps[s].parent] * t[steps[s].axis] * steps[s].inv;
 }
 
-// The M2L's two kernels are unrolled at compile time (a fold over the table
-// indices): every index and coefficient is a constant, so the compiler emits
-// straight-line multiply-adds on registers instead of a loop reading the
-// table (about 4× faster at p = 3).
-
-// One step of the recurrence: the sum in brackets for D_s, absent terms left out.
-template <int Q, std::size_t s>
-[[gnu::always_inline]] inline double recurrence_sum(const double* R, const double* D) {
-  constexpr RecurrenceStep r = make_recurrence<Q>()[s];
-  double sum = 0;
-  if constexpr (r.first[0] >= 0) sum += r.c1[0] * R[0] * D[r.first[0]];
-  if constexpr (r.first[1] >= 0) sum += r.c1[1] * R[1] * D[r.first[1]];
-  if constexpr (r.first[2] >= 0) sum += r.c1[2] * R[2] * D[r.first[2]];
-  if constexpr (r.second[0] >= 0) sum += r.c2[0] * D[r.second[0]];
-  if constexpr (r.second[1] >= 0) sum += r.c2[1] * D[r.second[1]];
-  if constexpr (r.second[2] >= 0) sum += r.c2[2] * D[r.second[2]];
-  return sum;
-}
-template <int Q, std::size_t... S>
-[[gnu::always_inline]] inline void recurrence(const double* R, double inv2, double* D, std::index_sequence<S...>) {
-  // The comma fold runs left to right: D_s only reads lower orders, already written.
-  ((D[S + 1] = recurrence_sum<Q, S + 1>(R, D) * inv2), ...);
-}
-
-// D_m(R) = ∂^m (|R|² + ε²)^{−1/2} for all m of order ≤ Q.
-template <int Q>
-inline void derivatives(double rx, double ry, double rz, double eps2, double* D) {
-  const double inv2 = 1.0 / (rx * rx + ry * ry + rz * rz + eps2);
-  const double R[3] = {rx, ry, rz};
-  D[0] = std::sqrt(inv2);
-  recurrence<Q>(R, inv2, D, std::make_index_sequence<std::size_t(coef_count(Q)) - 1>());
-}
-
-// The mutual contraction: C_k(A) += (−1)^{|n|} M_n(B) D_{k+n}, C_k(B) += M_n(A) D_{k+n}
-// (the parity (−1)^{|k|} of C(B) applied by the caller).
-template <int P, std::size_t... I>
-[[gnu::always_inline]] inline void contract(const double* Ma, const double* Mb, const double* D, double* ca, double* cb,
-                                            std::index_sequence<I...>) {
-  ((ca[Order<P>::m2l[I].out] += Order<P>::m2l[I].factor * Mb[Order<P>::m2l[I].in] * D[Order<P>::m2l[I].other],
-    cb[Order<P>::m2l[I].out] += Ma[Order<P>::m2l[I].in] * D[Order<P>::m2l[I].other]),
-   ...);
-}
-
 // Nodes per block of the level-by-level passes; a level of one block runs on
 // the calling thread (as in linear_octree.cpp). The same blocks either way.
 constexpr std::size_t kNodeBlock = 256;
@@ -287,6 +244,53 @@ inline double lane_sum(const double* v) {
 }
 // P2P buffer per chunk, doubles (a chunk holds at least one interaction).
 constexpr std::size_t kP2pBudget = std::size_t(1) << 18;
+
+// The M2L of kLanes pairs at once, lane l being pair l: the same operations
+// on every lane (so a pair's result does not depend on its lane), in
+// fixed-trip-count loops the compiler vectorizes across the pairs. Both
+// kernels are unrolled at compile time (a fold over the table indices): every
+// index and coefficient is a constant, so the compiler emits straight-line
+// vector multiply-adds instead of a loop reading the table.
+using Lanes = double[kLanes];
+
+template <int Q, std::size_t s>
+[[gnu::always_inline]] inline void recurrence_lanes(const Lanes* R, const Lanes& inv2, Lanes* D) {
+  constexpr RecurrenceStep r = make_recurrence<Q>()[s];
+#pragma omp simd
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    double sum = 0;
+    if constexpr (r.first[0] >= 0) sum += r.c1[0] * R[0][l] * D[r.first[0]][l];
+    if constexpr (r.first[1] >= 0) sum += r.c1[1] * R[1][l] * D[r.first[1]][l];
+    if constexpr (r.first[2] >= 0) sum += r.c1[2] * R[2][l] * D[r.first[2]][l];
+    if constexpr (r.second[0] >= 0) sum += r.c2[0] * D[r.second[0]][l];
+    if constexpr (r.second[1] >= 0) sum += r.c2[1] * D[r.second[1]][l];
+    if constexpr (r.second[2] >= 0) sum += r.c2[2] * D[r.second[2]][l];
+    D[s][l] = sum * inv2[l];
+  }
+}
+template <int Q, std::size_t... S>
+[[gnu::always_inline]] inline void derivatives_lanes(const Lanes* R, const Lanes& inv2, Lanes* D,
+                                                     std::index_sequence<S...>) {
+  // The comma fold runs left to right: D_s only reads lower orders, already written.
+  (recurrence_lanes<Q, S + 1>(R, inv2, D), ...);
+}
+
+template <int P, std::size_t I>
+[[gnu::always_inline]] inline void contract_lanes_term(const Lanes* Ma, const Lanes* Mb, const Lanes* D, Lanes* ca,
+                                                       Lanes* cb) {
+  constexpr Term t = Order<P>::m2l[I];
+#pragma omp simd
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    ca[t.out][l] += t.factor * Mb[t.in][l] * D[t.other][l];
+    cb[t.out][l] += Ma[t.in][l] * D[t.other][l];
+  }
+}
+// C_k(A) += (−1)^{|n|} M_n(B) D_{k+n},  C_k(B) += M_n(A) D_{k+n} (the parity (−1)^{|k|} applied by the caller).
+template <int P, std::size_t... I>
+[[gnu::always_inline]] inline void contract_lanes(const Lanes* Ma, const Lanes* Mb, const Lanes* D, Lanes* ca,
+                                                  Lanes* cb, std::index_sequence<I...>) {
+  (contract_lanes_term<P, I>(Ma, Mb, D, ca, cb), ...);
+}
 
 // Owner ranges for adding a chunk's buffers: any number gives the same sums
 // (each owner's terms are added in list order); more than the threads balance.
@@ -611,20 +615,37 @@ void Fmm<Real>::interact_m2l() {
   for (std::size_t start = 0; start < total; start += kM2lChunk) {
     const std::size_t count = std::min(kM2lChunk, total - start);
     parallel::for_blocks("fmm_m2l", count, 64, [&](std::size_t b, std::size_t e, std::size_t) {
-      double D[O::KL];
-      for (std::size_t q = b; q < e; ++q) {
-        const Pair pr = m2l_[start + q];
-        derivatives<O::Q>(zx_[pr.a] - zx_[pr.b], zy_[pr.a] - zy_[pr.b], zz_[pr.a] - zz_[pr.b], eps2, D);
-        const double* Ma = &multipoles_[std::size_t(pr.a) * O::KM];
-        const double* Mb = &multipoles_[std::size_t(pr.b) * O::KM];
-        double* ca = &buffer_[q * 2 * O::KL];
-        double* cb = ca + O::KL;
-        // C_k(A) += (−1)^{|n|} M_n(B) D_{k+n};  C_k(B) += (−1)^{|k|} M_n(A) D_{k+n}.
-        double sa[O::KL] = {}, sb[O::KL] = {};
-        contract<P>(Ma, Mb, D, sa, sb, std::make_index_sequence<O::m2l.size()>());
-        for (std::size_t k = 0; k < O::KL; ++k) {
-          ca[k] = sa[k];
-          cb[k] = O::parity[k] * sb[k];
+      alignas(64) Lanes R[3], inv2, D[O::KL], Ma[O::KM], Mb[O::KM], ca[O::KL], cb[O::KL];
+      for (std::size_t q0 = b; q0 < e; q0 += kLanes) {
+        // Lane l: pair q0 + l; lanes past the block's end repeat its last pair (their results are dropped).
+        for (std::size_t l = 0; l < kLanes; ++l) {
+          const Pair pr = m2l_[start + std::min(q0 + l, e - 1)];
+          R[0][l] = zx_[pr.a] - zx_[pr.b];
+          R[1][l] = zy_[pr.a] - zy_[pr.b];
+          R[2][l] = zz_[pr.a] - zz_[pr.b];
+          const double* ma = &multipoles_[std::size_t(pr.a) * O::KM];
+          const double* mb = &multipoles_[std::size_t(pr.b) * O::KM];
+          for (std::size_t k = 0; k < O::KM; ++k) {
+            Ma[k][l] = ma[k];
+            Mb[k][l] = mb[k];
+          }
+        }
+        // D_m(z_A − z_B), once for both directions (fmm.hpp).
+#pragma omp simd
+        for (std::size_t l = 0; l < kLanes; ++l) {
+          inv2[l] = 1.0 / (R[0][l] * R[0][l] + R[1][l] * R[1][l] + R[2][l] * R[2][l] + eps2);
+          D[0][l] = std::sqrt(inv2[l]);
+        }
+        derivatives_lanes<O::Q>(R, inv2, D, std::make_index_sequence<O::KL - 1>());
+        for (std::size_t k = 0; k < O::KL; ++k)
+          for (std::size_t l = 0; l < kLanes; ++l) ca[k][l] = cb[k][l] = 0;
+        contract_lanes<P>(Ma, Mb, D, ca, cb, std::make_index_sequence<O::m2l.size()>());
+        for (std::size_t l = 0; l < kLanes && q0 + l < e; ++l) {
+          double* out = &buffer_[(q0 + l) * 2 * O::KL];
+          for (std::size_t k = 0; k < O::KL; ++k) {
+            out[k] = ca[k][l];
+            out[O::KL + k] = O::parity[k] * cb[k][l];
+          }
         }
       }
     });
