@@ -11,7 +11,7 @@
 // interaction). Tables via bench.hpp's publish().
 //
 //   swirl bench bh-scale [--sizes 4096,...,8388608] [--threads 1,2] [--sample 10000] [--opening 0.5,...]
-//                        [--methods barnes_hut,fmm] [--fmm-orders 2,3,4,5]
+//                        [--methods barnes_hut,fmm] [--fmm-orders 2,3,4,5] [--fmm-buckets 32,...]
 //                        [--multipoles monopole,quadrupole] [--criteria paper,barnes] [--walks group,particle]
 //                        [--bucket 16,...] [--group-sizes 64,...] [--repeats N] [--precision double,float]
 //                        [--out DIR] [--quick]
@@ -51,6 +51,7 @@ struct BhScaleArgs {
   std::vector<double> openings{0.5};
   std::vector<std::string> methods{"barnes_hut", "fmm"};
   std::vector<int> fmm_orders{3};
+  std::vector<std::size_t> fmm_buckets;  // empty: the --bucket list
   double softening = 0.01;
   std::vector<std::string> multipoles{"monopole", "quadrupole"};
   std::vector<std::string> criteria{"paper", "barnes"};
@@ -141,7 +142,8 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
       if (method == "fmm") {
         for (int order : a.fmm_orders)
           for (double opening : a.openings)
-            for (std::size_t bucket : a.buckets) points.push_back({"-", "-", "-", opening, bucket, 0, order});
+            for (std::size_t bucket : a.fmm_buckets.empty() ? a.buckets : a.fmm_buckets)
+              points.push_back({"-", "-", "-", opening, bucket, 0, order});
         continue;
       }
       for (const auto& mp : a.multipoles)
@@ -322,6 +324,7 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
                   {"opening", joined(a.openings)},
                   {"methods", joined(a.methods)},
                   {"fmm_orders", joined(a.fmm_orders)},
+                  {"fmm_buckets", a.fmm_buckets.empty() ? joined(a.buckets) : joined(a.fmm_buckets)},
                   {"softening", fmt::format("{}", a.softening)},
                   {"walks", joined(a.walks)},
                   {"bucket", joined(a.buckets)},
@@ -377,6 +380,9 @@ void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands) {
   c->add_option("--softening", args->softening, "epsilon")->check(non_negative_finite());
   c->add_option("--methods", args->methods, "barnes_hut,fmm (default both)")->delimiter(',');
   c->add_option("--fmm-orders", args->fmm_orders, "FMM expansion orders p in [2, 5] (default 3)")->delimiter(',');
+  c->add_option("--fmm-buckets", args->fmm_buckets, "FMM leaf sizes (default: the --bucket list)")
+      ->delimiter(',')
+      ->check(whole_number(1, kMaxCount));
   c->add_option("--multipoles", args->multipoles, "monopole,quadrupole")->delimiter(',');
   c->add_option("--criteria", args->criteria, "paper,barnes")->delimiter(',');
   c->add_option("--walks", args->walks, "group,particle (default group)")->delimiter(',');

@@ -285,11 +285,26 @@ template <int P, std::size_t I>
     cb[t.out][l] += Ma[t.in][l] * D[t.other][l];
   }
 }
-// C_k(A) += (−1)^{|n|} M_n(B) D_{k+n},  C_k(B) += M_n(A) D_{k+n} (the parity (−1)^{|k|} applied by the caller).
-template <int P, std::size_t... I>
+// Terms per fold expression: clang caps a fold's nesting at 256.
+constexpr std::size_t kFold = 128;
+template <int P, std::size_t base, std::size_t... I>
+[[gnu::always_inline]] inline void contract_fold(const Lanes* Ma, const Lanes* Mb, const Lanes* D, Lanes* ca, Lanes* cb,
+                                                 std::index_sequence<I...>) {
+  (contract_lanes_term<P, base + I>(Ma, Mb, D, ca, cb), ...);
+}
+template <int P, std::size_t... G>
+[[gnu::always_inline]] inline void contract_folds(const Lanes* Ma, const Lanes* Mb, const Lanes* D, Lanes* ca,
+                                                  Lanes* cb, std::index_sequence<G...>) {
+  constexpr std::size_t n = Order<P>::m2l.size();
+  (contract_fold<P, G * kFold>(Ma, Mb, D, ca, cb, std::make_index_sequence<std::min(kFold, n - G * kFold)>()), ...);
+}
+// C_k(A) += (−1)^{|n|} M_n(B) D_{k+n},  C_k(B) += M_n(A) D_{k+n} (the parity (−1)^{|k|} applied by the caller),
+// in table order.
+template <int P>
 [[gnu::always_inline]] inline void contract_lanes(const Lanes* Ma, const Lanes* Mb, const Lanes* D, Lanes* ca,
-                                                  Lanes* cb, std::index_sequence<I...>) {
-  (contract_lanes_term<P, I>(Ma, Mb, D, ca, cb), ...);
+                                                  Lanes* cb) {
+  constexpr std::size_t n = Order<P>::m2l.size();
+  contract_folds<P>(Ma, Mb, D, ca, cb, std::make_index_sequence<(n + kFold - 1) / kFold>());
 }
 
 // Owner ranges for adding a chunk's buffers: any number gives the same sums
@@ -639,7 +654,7 @@ void Fmm<Real>::interact_m2l() {
         derivatives_lanes<O::Q>(R, inv2, D, std::make_index_sequence<O::KL - 1>());
         for (std::size_t k = 0; k < O::KL; ++k)
           for (std::size_t l = 0; l < kLanes; ++l) ca[k][l] = cb[k][l] = 0;
-        contract_lanes<P>(Ma, Mb, D, ca, cb, std::make_index_sequence<O::m2l.size()>());
+        contract_lanes<P>(Ma, Mb, D, ca, cb);
         for (std::size_t l = 0; l < kLanes && q0 + l < e; ++l) {
           double* out = &buffer_[(q0 + l) * 2 * O::KL];
           for (std::size_t k = 0; k < O::KL; ++k) {
