@@ -307,6 +307,44 @@ template <int P>
   contract_folds<P>(Ma, Mb, D, ca, cb, std::make_index_sequence<(n + kFold - 1) / kFold>());
 }
 
+// The mutual M2L of the pairs (ia[l], ib[l]), l < kLanes: out + l·2K holds
+// C(A) then C(B) of lane l (K = coef_count(p + 1)) for l < valid. A free
+// function of the order alone (not of the particles' type): compiled once per p.
+template <int P>
+void m2l_lanes(const std::array<std::uint32_t, kLanes>& ia, const std::array<std::uint32_t, kLanes>& ib,
+               const double* zx, const double* zy, const double* zz, const double* multipoles, double eps2,
+               double* out, std::size_t valid) {
+  using O = Order<P>;
+  alignas(64) Lanes R[3], inv2, D[O::KL], Ma[O::KM], Mb[O::KM], ca[O::KL], cb[O::KL];
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    const std::size_t a = ia[l], b = ib[l];
+    R[0][l] = zx[a] - zx[b];
+    R[1][l] = zy[a] - zy[b];
+    R[2][l] = zz[a] - zz[b];
+    for (std::size_t k = 0; k < O::KM; ++k) {
+      Ma[k][l] = multipoles[a * O::KM + k];
+      Mb[k][l] = multipoles[b * O::KM + k];
+    }
+  }
+  // D_m(z_A − z_B), once for both directions (fmm.hpp).
+#pragma omp simd
+  for (std::size_t l = 0; l < kLanes; ++l) {
+    inv2[l] = 1.0 / (R[0][l] * R[0][l] + R[1][l] * R[1][l] + R[2][l] * R[2][l] + eps2);
+    D[0][l] = std::sqrt(inv2[l]);
+  }
+  derivatives_lanes<O::Q>(R, inv2, D, std::make_index_sequence<O::KL - 1>());
+  for (std::size_t k = 0; k < O::KL; ++k)
+    for (std::size_t l = 0; l < kLanes; ++l) ca[k][l] = cb[k][l] = 0;
+  contract_lanes<P>(Ma, Mb, D, ca, cb);
+  for (std::size_t l = 0; l < valid; ++l) {
+    double* o = out + l * 2 * O::KL;
+    for (std::size_t k = 0; k < O::KL; ++k) {
+      o[k] = ca[k][l];
+      o[O::KL + k] = O::parity[k] * cb[k][l];
+    }
+  }
+}
+
 // Owner ranges for adding a chunk's buffers: any number gives the same sums
 // (each owner's terms are added in list order); more than the threads balance.
 std::size_t owner_ranges() { return std::size_t(4 * parallel::thread_count()); }
@@ -630,38 +668,16 @@ void Fmm<Real>::interact_m2l() {
   for (std::size_t start = 0; start < total; start += kM2lChunk) {
     const std::size_t count = std::min(kM2lChunk, total - start);
     parallel::for_blocks("fmm_m2l", count, 64, [&](std::size_t b, std::size_t e, std::size_t) {
-      alignas(64) Lanes R[3], inv2, D[O::KL], Ma[O::KM], Mb[O::KM], ca[O::KL], cb[O::KL];
+      std::array<std::uint32_t, kLanes> ia, ib;
       for (std::size_t q0 = b; q0 < e; q0 += kLanes) {
         // Lane l: pair q0 + l; lanes past the block's end repeat its last pair (their results are dropped).
         for (std::size_t l = 0; l < kLanes; ++l) {
           const Pair pr = m2l_[start + std::min(q0 + l, e - 1)];
-          R[0][l] = zx_[pr.a] - zx_[pr.b];
-          R[1][l] = zy_[pr.a] - zy_[pr.b];
-          R[2][l] = zz_[pr.a] - zz_[pr.b];
-          const double* ma = &multipoles_[std::size_t(pr.a) * O::KM];
-          const double* mb = &multipoles_[std::size_t(pr.b) * O::KM];
-          for (std::size_t k = 0; k < O::KM; ++k) {
-            Ma[k][l] = ma[k];
-            Mb[k][l] = mb[k];
-          }
+          ia[l] = pr.a;
+          ib[l] = pr.b;
         }
-        // D_m(z_A − z_B), once for both directions (fmm.hpp).
-#pragma omp simd
-        for (std::size_t l = 0; l < kLanes; ++l) {
-          inv2[l] = 1.0 / (R[0][l] * R[0][l] + R[1][l] * R[1][l] + R[2][l] * R[2][l] + eps2);
-          D[0][l] = std::sqrt(inv2[l]);
-        }
-        derivatives_lanes<O::Q>(R, inv2, D, std::make_index_sequence<O::KL - 1>());
-        for (std::size_t k = 0; k < O::KL; ++k)
-          for (std::size_t l = 0; l < kLanes; ++l) ca[k][l] = cb[k][l] = 0;
-        contract_lanes<P>(Ma, Mb, D, ca, cb);
-        for (std::size_t l = 0; l < kLanes && q0 + l < e; ++l) {
-          double* out = &buffer_[(q0 + l) * 2 * O::KL];
-          for (std::size_t k = 0; k < O::KL; ++k) {
-            out[k] = ca[k][l];
-            out[O::KL + k] = O::parity[k] * cb[k][l];
-          }
-        }
+        m2l_lanes<P>(ia, ib, zx_.data(), zy_.data(), zz_.data(), multipoles_.data(), eps2,
+                     &buffer_[q0 * 2 * O::KL], std::min(kLanes, e - q0));
       }
     });
     const std::size_t ranges = std::min(owner_ranges(), nodes);
