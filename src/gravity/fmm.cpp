@@ -730,15 +730,15 @@ void Fmm<Real>::interact_p2p() {
       // The source cell's particles in double, padded with massless ones at
       // the origin to a multiple of kLanes, so that the vector loops below run
       // whole vectors (a padded source adds exactly 0: m = 0, and 1/R = 0 at R = 0).
-      std::vector<double> sx_, sy_, sz_, sm_, fx_, fy_, fz_, fp_;
+      std::vector<double> src_x, src_y, src_z, src_m, src_ax, src_ay, src_az, src_phi;
       const auto load = [&](std::uint32_t c) {
         const std::size_t c0 = t.begin[c], nc = t.end[c] - c0, padded = (nc + kLanes - 1) / kLanes * kLanes;
-        for (auto* v : {&sx_, &sy_, &sz_, &sm_, &fx_, &fy_, &fz_, &fp_}) v->assign(padded, 0.0);
+        for (auto* v : {&src_x, &src_y, &src_z, &src_m, &src_ax, &src_ay, &src_az, &src_phi}) v->assign(padded, 0.0);
         for (std::size_t k = 0; k < nc; ++k) {
-          sx_[k] = double(x[c0 + k]);
-          sy_[k] = double(y[c0 + k]);
-          sz_[k] = double(z[c0 + k]);
-          sm_[k] = double(m[c0 + k]);
+          src_x[k] = double(x[c0 + k]);
+          src_y[k] = double(y[c0 + k]);
+          src_z[k] = double(z[c0 + k]);
+          src_m[k] = double(m[c0 + k]);
         }
         return padded;
       };
@@ -749,8 +749,8 @@ void Fmm<Real>::interact_p2p() {
         double* sa = &buffer_[offsets_[q]];
         double *ax = sa, *ay = ax + na, *az = ay + na, *ap = az + na;
         const std::size_t nb = load(pr.b);
-        const double *bx = sx_.data(), *by = sy_.data(), *bz = sz_.data(), *bm = sm_.data();
-        double *gx = fx_.data(), *gy = fy_.data(), *gz = fz_.data(), *gp = fp_.data();
+        const double *bx = src_x.data(), *by = src_y.data(), *bz = src_z.data(), *bm = src_m.data();
+        double *gx = src_ax.data(), *gy = src_ay.data(), *gz = src_az.data(), *gp = src_phi.data();
         if (pr.a == pr.b) {
           // Within the cell, each particle from all the others: every pair
           // twice, its term on j the negation of its term on i with the same
