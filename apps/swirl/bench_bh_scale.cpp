@@ -8,7 +8,8 @@
 // particle. The fast multipole method (fmm.hpp) is a second method on the
 // same tree: for each expansion order, θ and bucket size, the same columns
 // (its interactions: two per mutual M2L or particle pair; nodes: two per cell
-// interaction). Tables via bench.hpp's publish().
+// interaction). Time per evaluation both as wall time and as the process's
+// CPU time (all threads). Tables via bench.hpp's publish().
 //
 //   swirl bench bh-scale [--sizes 4096,...,8388608] [--threads 1,2] [--sample 10000] [--opening 0.5,...]
 //                        [--methods barnes_hut,fmm] [--fmm-orders 2,3,4,5] [--fmm-buckets 32,...]
@@ -20,6 +21,7 @@
 // walk only; multipoles, criteria and walks to Barnes–Hut, the orders to the FMM.
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -70,6 +72,14 @@ std::string command_line() {
     if (c == '\0') c = ' ';
   while (!raw.empty() && raw.back() == ' ') raw.pop_back();
   return raw.empty() ? "swirl bench bh-scale" : raw;
+}
+
+// CPU seconds of the whole process (every thread): on a shared machine the
+// wall time carries the other users' load, the CPU time much less of it.
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -183,16 +193,18 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
           gravity::BarnesHut<Real> tree(g);
           gravity::Fmm<Real> multipole(gravity::FmmSettings{fmm ? pt.order : 3, pt.opening, a.softening, pt.bucket});
           gravity::GravityField<Real> field;
-          std::vector<double> total, build, walk;
+          std::vector<double> total, build, walk, cpu;
           gravity::GravityStats st;
           for (int r = 0; r < repeats; ++r) {
             const auto t0 = std::chrono::steady_clock::now();
+            const double c0 = cpu_seconds();
             if (fmm) {
               multipole.compute(p, field, 1024);
             } else {
               tree.compute(p, field, 1024);
             }
             total.push_back(seconds_since(t0));
+            cpu.push_back(cpu_seconds() - c0);
             if (fmm) {
               // The FMM's phases in the Barnes–Hut columns: build = tree + upward pass, walk = the rest.
               const gravity::FmmStats& fs = multipole.stats();
@@ -235,6 +247,7 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
                                  : fmt::format("{}/{}/{}/{}", precision, mp, cr, pt.walk)),
                  bench::integer(th),
                  bench::integer(repeats), bench::significant(1e3 * median(total), 4),
+                 bench::significant(1e3 * median(cpu), 4),
                  bench::significant(1e3 * median(build), 4), bench::significant(1e3 * median(walk), 4),
                  bench::significant(1e9 * median(total) / double(n), 4),
                  bench::significant(1e-6 * interactions_per_second, 4),
@@ -295,6 +308,7 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
                {"threads", "threads"},
                {"repeats", "evaluations"},
                {"ms_per_evaluation", "ms / evaluation (median)"},
+               {"cpu_ms_per_evaluation", "CPU ms / evaluation (median, all threads)"},
                {"ms_build", "ms build"},
                {"ms_walk", "ms walk"},
                {"ns_per_particle", "ns / particle"},
