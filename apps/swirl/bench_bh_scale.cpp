@@ -5,16 +5,23 @@
 // median and 99th-percentile relative force error on a random sample of
 // particles against the direct sum in double (a full direct sum at 10⁶
 // particles takes minutes), interactions and nodes per particle, and bytes per
-// particle. Tables via bench.hpp's publish().
+// particle. The fast multipole method (fmm.hpp) is a second method on the
+// same tree: for each expansion order, θ and bucket size, the same columns
+// (its interactions: two per mutual M2L or particle pair; nodes: two per cell
+// interaction). Time per evaluation both as wall time and as the process's
+// CPU time (all threads). Tables via bench.hpp's publish().
 //
 //   swirl bench bh-scale [--sizes 4096,...,8388608] [--threads 1,2] [--sample 10000] [--opening 0.5,...]
+//                        [--methods barnes_hut,fmm] [--fmm-orders 2,3,4,5] [--fmm-buckets 32,...]
 //                        [--multipoles monopole,quadrupole] [--criteria paper,barnes] [--walks group,particle]
 //                        [--bucket 16,...] [--group-sizes 64,...] [--repeats N] [--precision double,float]
 //                        [--out DIR] [--quick]
 //
-// Every list is a dimension of the table; the group size applies to the group walk only.
+// Every list is a dimension of the table; the group size applies to the group
+// walk only; multipoles, criteria and walks to Barnes–Hut, the orders to the FMM.
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -32,6 +39,7 @@
 #include "flags.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/gravity/barnes_hut.hpp"
+#include "swirl/gravity/fmm.hpp"
 #include "swirl/gravity/initial_conditions.hpp"
 #include "swirl/gravity/pair_law.hpp"
 #include "swirl/parallel/for_blocks.hpp"
@@ -43,6 +51,9 @@ struct BhScaleArgs {
   std::vector<std::size_t> sizes;  // default 2^12 .. 2^23
   std::size_t sample = 10000;
   std::vector<double> openings{0.5};
+  std::vector<std::string> methods{"barnes_hut", "fmm"};
+  std::vector<int> fmm_orders{3};
+  std::vector<std::size_t> fmm_buckets;  // empty: the --bucket list
   double softening = 0.01;
   std::vector<std::string> multipoles{"monopole", "quadrupole"};
   std::vector<std::string> criteria{"paper", "barnes"};
@@ -61,6 +72,14 @@ std::string command_line() {
     if (c == '\0') c = ' ';
   while (!raw.empty() && raw.back() == ' ') raw.pop_back();
   return raw.empty() ? "swirl bench bh-scale" : raw;
+}
+
+// CPU seconds of the whole process (every thread): on a shared machine the
+// wall time carries the other users' load, the CPU time much less of it.
+double cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -125,47 +144,82 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
     struct Point {
       std::string mp, cr, walk;
       double opening;
-      std::size_t bucket, group;  // group 0: the per-particle walk
+      std::size_t bucket, group;  // group 0: the per-particle walk (or the FMM)
+      int order = 0;              // 0: Barnes–Hut; 2..5: the FMM's expansion order
     };
     std::vector<Point> points;
-    for (const auto& mp : a.multipoles)
-      for (const auto& cr : a.criteria)
-        for (const auto& wk : a.walks)
+    for (const auto& method : a.methods) {
+      if (method == "fmm") {
+        for (int order : a.fmm_orders)
           for (double opening : a.openings)
-            for (std::size_t bucket : a.buckets) {
-              if (wk == "particle") {
-                points.push_back({mp, cr, wk, opening, bucket, 0});
-                continue;
+            for (std::size_t bucket : a.fmm_buckets.empty() ? a.buckets : a.fmm_buckets)
+              points.push_back({"-", "-", "-", opening, bucket, 0, order});
+        continue;
+      }
+      for (const auto& mp : a.multipoles)
+        for (const auto& cr : a.criteria)
+          for (const auto& wk : a.walks)
+            for (double opening : a.openings)
+              for (std::size_t bucket : a.buckets) {
+                if (wk == "particle") {
+                  points.push_back({mp, cr, wk, opening, bucket, 0});
+                  continue;
+                }
+                for (std::size_t group : a.group_sizes) points.push_back({mp, cr, wk, opening, bucket, group});
               }
-              for (std::size_t group : a.group_sizes) points.push_back({mp, cr, wk, opening, bucket, group});
-            }
+    }
     for (const Point& pt : points) {
       {
         const auto& mp = pt.mp;
         const auto& cr = pt.cr;
+        const bool fmm = pt.order > 0;
         gravity::GravitySettings g;
         g.scheme = gravity::Scheme::Global;
         g.tree = gravity::Tree::Linear;
-        g.multipole = gravity::parse_multipole(mp);
-        g.criterion = gravity::parse_criterion(cr);
-        g.walk = gravity::parse_walk(pt.walk);
+        if (!fmm) {
+          g.multipole = gravity::parse_multipole(mp);
+          g.criterion = gravity::parse_criterion(cr);
+          g.walk = gravity::parse_walk(pt.walk);
+        }
         g.opening = pt.opening;
         g.softening = a.softening;
         g.bucket_size = pt.bucket;
         if (pt.group) g.group_size = pt.group;
         for (int th : threads) {
-          bench::progress(fmt::format("bh-scale: N = {}, {}, {}, {} walk, theta {}, bucket {}, group {}, {}, {} threads",
-                                      n, mp, cr, pt.walk, pt.opening, pt.bucket, pt.group, precision, th));
+          const std::string method = fmm ? fmt::format("fmm p={}", pt.order) : std::string("barnes_hut");
+          bench::progress(fmt::format("bh-scale: N = {}, {}, {}, {}, {} walk, theta {}, bucket {}, group {}, {}, {} threads",
+                                      n, method, mp, cr, pt.walk, pt.opening, pt.bucket, pt.group, precision, th));
           parallel::set_thread_count(th);
           gravity::BarnesHut<Real> tree(g);
+          gravity::Fmm<Real> multipole(gravity::FmmSettings{fmm ? pt.order : 3, pt.opening, a.softening, pt.bucket});
           gravity::GravityField<Real> field;
-          std::vector<double> total, build, walk;
+          std::vector<double> total, build, walk, cpu;
+          gravity::GravityStats st;
           for (int r = 0; r < repeats; ++r) {
             const auto t0 = std::chrono::steady_clock::now();
-            tree.compute(p, field, 1024);
+            const double c0 = cpu_seconds();
+            if (fmm) {
+              multipole.compute(p, field, 1024);
+            } else {
+              tree.compute(p, field, 1024);
+            }
             total.push_back(seconds_since(t0));
-            build.push_back(tree.stats().tree_build_seconds);
-            walk.push_back(tree.stats().force_seconds);
+            cpu.push_back(cpu_seconds() - c0);
+            if (fmm) {
+              // The FMM's phases in the Barnes–Hut columns: build = tree + upward pass, walk = the rest.
+              const gravity::FmmStats& fs = multipole.stats();
+              st = gravity::GravityStats{};
+              st.mean_interactions = 2.0 * double(fs.m2l + fs.p2p_pairs) / double(n);
+              st.mean_nodes_visited = 2.0 * double(fs.m2l + fs.p2p_cells) / double(n);
+              st.leaves = fs.leaves;
+              st.tree_bytes = fs.bytes;
+              st.tree_build_seconds = fs.tree_seconds + fs.upward_seconds;
+              st.force_seconds = fs.walk_seconds + fs.m2l_seconds + fs.p2p_seconds + fs.downward_seconds;
+            } else {
+              st = tree.stats();
+            }
+            build.push_back(st.tree_build_seconds);
+            walk.push_back(st.force_seconds);
           }
           auto median = [](std::vector<double> v) {
             std::sort(v.begin(), v.end());
@@ -182,15 +236,18 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
             err[k] = r2 > 0 ? std::sqrt(d2 / r2) : std::sqrt(d2);
           }
           std::sort(err.begin(), err.end());
-          const auto& st = tree.stats();
           const double tree_bpp = double(st.tree_bytes) / double(n);
           const double field_bpp = 4.0 * sizeof(Real);
           const double interactions_per_second = st.mean_interactions * double(n) / median(walk);
-          t.add({bench::integer(static_cast<long long>(n)), bench::text(precision), bench::text(mp), bench::text(cr),
+          t.add({bench::integer(static_cast<long long>(n)), bench::text(precision), bench::text(fmm ? "fmm" : "barnes_hut"),
+                 bench::text(fmm ? std::to_string(pt.order) : "-"), bench::text(mp), bench::text(cr),
                  bench::text(pt.walk), bench::number(pt.opening, 2), bench::integer(static_cast<long long>(pt.bucket)),
                  bench::text(pt.group ? std::to_string(pt.group) : "-"),
-                 bench::text(fmt::format("{}/{}/{}/{}", precision, mp, cr, pt.walk)), bench::integer(th),
+                 bench::text(fmm ? fmt::format("{}/fmm/p{}", precision, pt.order)
+                                 : fmt::format("{}/{}/{}/{}", precision, mp, cr, pt.walk)),
+                 bench::integer(th),
                  bench::integer(repeats), bench::significant(1e3 * median(total), 4),
+                 bench::significant(1e3 * median(cpu), 4),
                  bench::significant(1e3 * median(build), 4), bench::significant(1e3 * median(walk), 4),
                  bench::significant(1e9 * median(total) / double(n), 4),
                  bench::significant(1e-6 * interactions_per_second, 4),
@@ -214,7 +271,12 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
     a.sample = 500;
     a.repeats = 1;
   }
-  for (const auto& m : a.multipoles) gravity::parse_multipole(m);  // reject unknown names before measuring
+  for (const auto& m : a.methods)  // reject unknown names before measuring
+    if (m != "barnes_hut" && m != "fmm")
+      throw std::invalid_argument(fmt::format("--methods: \"{}\" is neither \"barnes_hut\" nor \"fmm\"", m));
+  for (int order : a.fmm_orders)
+    if (order < 2 || order > 5) throw std::invalid_argument(fmt::format("--fmm-orders: {} is outside [2, 5]", order));
+  for (const auto& m : a.multipoles) gravity::parse_multipole(m);
   for (const auto& c : a.criteria) gravity::parse_criterion(c);
   for (const auto& w : a.walks) gravity::parse_walk(w);
   for (const auto& p : a.precisions)
@@ -228,10 +290,14 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
     for (const auto& v : list) s += fmt::format("{}{}", s.empty() ? "" : ",", v);
     return s;
   };
-  t.title = fmt::format("Linear octree: time, accuracy and memory against N (θ or λ = {}, bucket {}, group {}, {})",
-                        joined(a.openings), joined(a.buckets), joined(a.group_sizes), joined(a.precisions));
+  t.title = fmt::format("Linear octree, Barnes-Hut and FMM: time, accuracy and memory against N (θ or λ = {}, bucket {}, "
+                        "group {}, FMM orders {}, {})",
+                        joined(a.openings), joined(a.buckets), joined(a.group_sizes), joined(a.fmm_orders),
+                        joined(a.precisions));
   t.columns = {{"particles", "N"},
                {"precision", "precision"},
+               {"method", "method"},
+               {"order", "FMM order p"},
                {"multipole", "multipole"},
                {"criterion", "criterion"},
                {"walk", "walk"},
@@ -242,6 +308,7 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
                {"threads", "threads"},
                {"repeats", "evaluations"},
                {"ms_per_evaluation", "ms / evaluation (median)"},
+               {"cpu_ms_per_evaluation", "CPU ms / evaluation (median, all threads)"},
                {"ms_build", "ms build"},
                {"ms_walk", "ms walk"},
                {"ns_per_particle", "ns / particle"},
@@ -269,6 +336,9 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
   for (std::size_t n : a.sizes) sizes += fmt::format("{}{}", sizes.empty() ? "" : ",", n);
   r.parameters = {{"sizes", sizes},
                   {"opening", joined(a.openings)},
+                  {"methods", joined(a.methods)},
+                  {"fmm_orders", joined(a.fmm_orders)},
+                  {"fmm_buckets", a.fmm_buckets.empty() ? joined(a.buckets) : joined(a.fmm_buckets)},
                   {"softening", fmt::format("{}", a.softening)},
                   {"walks", joined(a.walks)},
                   {"bucket", joined(a.buckets)},
@@ -283,7 +353,10 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
       "|a_direct| on a random sample of particles against the direct sum in double. Interactions: node expansions "
       "plus particle pairs per particle; M interactions / s: all of them over the walk's time. Tree B / particle: the tree's memory (nodes, sorted copies, keys, sort "
       "buffers); total adds the particle fields (ParticleSet) and the field output. `paper` = the paper's rule "
-      "l/d < λ, `barnes` = Barnes' rule d > l/θ + δ (docs/gravity.md).";
+      "l/d < λ, `barnes` = Barnes' rule d > l/θ + δ (docs/gravity.md). `fmm`: the fast multipole method on the same "
+      "tree (fmm.hpp), cells interacting iff r_A + r_B < θ |z_A − z_B|, expansions of order p; build = tree + "
+      "multipoles, walk = dual walk + M2L + P2P + L2L/L2P; interactions = 2 × (M2L + particle pairs) / N "
+      "(every interaction is mutual), nodes = 2 × cell interactions / N.";
   bench::PlotPanel time;
   time.x = "particles";
   time.xlabel = "N";
@@ -306,8 +379,8 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
 void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands) {
   auto args = std::make_shared<BhScaleArgs>();
   auto common = std::make_shared<bench::CommonArgs>();
-  auto* c = bench_cmd.add_subcommand("bh-scale", "Barnes-Hut linear octree from 2^12 to 2^23 particles: time, "
-                                                 "sampled force error, interactions and bytes per particle");
+  auto* c = bench_cmd.add_subcommand("bh-scale", "Barnes-Hut and the FMM on the linear octree from 2^12 to 2^23 "
+                                                 "particles: time, sampled force error, interactions and bytes per particle");
   c->add_option("--sizes", args->sizes, "Particle counts (default 4096,...,8388608)")
       ->delimiter(',')
       ->check(whole_number(1, kMaxCount));
@@ -319,6 +392,11 @@ void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands) {
       ->delimiter(',')
       ->check(number_in(0.0, 1.0));
   c->add_option("--softening", args->softening, "epsilon")->check(non_negative_finite());
+  c->add_option("--methods", args->methods, "barnes_hut,fmm (default both)")->delimiter(',');
+  c->add_option("--fmm-orders", args->fmm_orders, "FMM expansion orders p in [2, 5] (default 3)")->delimiter(',');
+  c->add_option("--fmm-buckets", args->fmm_buckets, "FMM leaf sizes (default: the --bucket list)")
+      ->delimiter(',')
+      ->check(whole_number(1, kMaxCount));
   c->add_option("--multipoles", args->multipoles, "monopole,quadrupole")->delimiter(',');
   c->add_option("--criteria", args->criteria, "paper,barnes")->delimiter(',');
   c->add_option("--walks", args->walks, "group,particle (default group)")->delimiter(',');

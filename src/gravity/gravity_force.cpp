@@ -13,9 +13,21 @@
 
 namespace swirl::gravity {
 
+namespace {
+FmmSettings fmm_settings(const GravitySettings& g) {
+  validate(g);  // before the conversion: fmm_order is checked here
+  FmmSettings f;
+  f.order = int(g.fmm_order);
+  f.opening = g.opening;
+  f.softening = g.softening;
+  f.bucket_size = g.bucket_size;
+  return f;
+}
+}  // namespace
+
 template <class Real>
 GravityForce<Real>::GravityForce(const GravitySettings& settings, const SelfGravityOptions& options)
-    : settings_(settings), options_(options), tree_(settings) {
+    : settings_(settings), options_(options), tree_(settings), fmm_(fmm_settings(settings)) {
   if (!(options.G > 0) || !std::isfinite(options.G))
     throw std::invalid_argument("gravity: the gravitational constant G must be finite and > 0");
   if (!(options.eta > 0) || !std::isfinite(options.eta))
@@ -24,6 +36,7 @@ GravityForce<Real>::GravityForce(const GravitySettings& settings, const SelfGrav
 
 template <class Real>
 bool GravityForce<Real>::views_order() const {
+  if (settings_.method == Method::Fmm) return settings_.reorder;
   return settings_.method == Method::BarnesHut && settings_.reorder && tree_.uses_linear_tree();
 }
 
@@ -48,6 +61,31 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     stats_.mean_nodes_visited = p.empty() ? 0.0 : double(p.size() - 1);
     for (std::size_t i = 0; i < p.size(); ++i) stats_.walked += ctx.active.contains(i);
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  } else if (settings_.method == Method::Fmm) {
+    // Every particle, whatever the active set (fmm.hpp); the loop below writes the active ones.
+    const auto* order = ctx.order;
+    if (views_order() && order && order->valid() && order->frame().curve == spatial::CellOrder::Morton &&
+        order->keys().size() == p.size()) {
+      const auto& f = order->frame();
+      fmm_.compute_sorted(p, order->keys(), f.corner, f.root_side(), field_, ctx.block_size);
+    } else {
+      fmm_.compute(p, field_, ctx.block_size);
+    }
+    const FmmStats& fs = fmm_.stats();
+    stats_ = GravityStats{};
+    const double n = p.empty() ? 1.0 : double(p.size());
+    // Per particle: the cell interactions (M2L and P2P cell pairs) it takes part in
+    // and the terms evaluated (two per mutual interaction: one for each side).
+    stats_.mean_nodes_visited = 2.0 * double(fs.m2l + fs.p2p_cells) / n;
+    stats_.mean_interactions = 2.0 * double(fs.m2l + fs.p2p_pairs) / n;
+    stats_.walked = p.size();
+    stats_.trees = 1;
+    stats_.nodes = fs.nodes;
+    stats_.depth = fs.depth;
+    stats_.leaves = fs.leaves;
+    stats_.tree_bytes = fs.bytes;
+    stats_.tree_build_seconds = fs.tree_seconds + fs.upward_seconds;
+    stats_.force_seconds = fs.walk_seconds + fs.m2l_seconds + fs.p2p_seconds + fs.downward_seconds;
   } else {
     const auto* order = ctx.order;
     if (views_order() && order && order->valid() && order->frame().curve == spatial::CellOrder::Morton &&

@@ -56,6 +56,8 @@ void validate(const GravitySettings& s) {
   if (s.subtree_parts < 1) throw std::invalid_argument("gravity subtree_parts must be at least 1 part");
   if (s.bucket_size < 1) throw std::invalid_argument("gravity bucket_size must be at least 1 particle");
   if (s.group_size < 1) throw std::invalid_argument("gravity group_size must be at least 1 particle");
+  if (!(s.fmm_order >= 2 && s.fmm_order <= 5))
+    throw std::invalid_argument(fmt::format("gravity fmm_order p = {} is outside [2, 5]", s.fmm_order));
 }
 
 }  // namespace swirl::gravity

@@ -213,6 +213,8 @@ constexpr Range kAtLeastOne{1, std::numeric_limits<double>::infinity(), false, f
 constexpr Range kParticleCount{1, static_cast<double>(detail::kMaxParticles), false, false};
 // Sizes of tree nodes and groups: 1 to 2^20.
 constexpr Range kTreeSize{1, 1 << 20, false, false};
+// The FMM's expansion orders (fmm.hpp).
+constexpr Range kFmmOrder{2, 5, false, false};
 // A length beyond 1e9 m is a typo; it would also overflow h³.
 constexpr Range kSupport{0, 1e9, true, false};
 constexpr Range kNeighbourCount{0, 10000, true, false};
@@ -426,12 +428,16 @@ std::vector<SceneKey> declare_scene_keys() {
   using gravity::GravitySettings;
   const auto linear_tree = [](const Scene& s) { return s.nbody && s.nbody->tree == gravity::Tree::Linear; };
   add(field(SceneKey{.key = "nbody.method", .section = "nbody", .noun = "method",
-                     .doc = "`\"barnes_hut\"` or `\"direct\"` (the exact O(N²) sum)"},
+                     .doc = "`\"barnes_hut\"`, `\"direct\"` (the exact O(N²) sum) or `\"fmm\"` (the fast multipole "
+                            "method: mutual cell–cell expansions of order `fmm_order` on the linear octree; "
+                            "docs/gravity.md)"},
             in_nbody(&GravitySettings::method)));
   add(field(SceneKey{.key = "nbody.scheme", .section = "nbody", .noun = "scheme",
                      .doc = "`\"subdomain\"`, `\"subtree\"` (the paper's 4.1, 4.2) or `\"global\"`"},
             in_nbody(&GravitySettings::scheme)));
-  add(field(SceneKey{.key = "nbody.opening", .section = "nbody", .range = kUnit, .doc = "λ; 0 gives the direct sum"},
+  add(field(SceneKey{.key = "nbody.opening", .section = "nbody", .range = kUnit,
+                     .doc = "λ (paper rule) or θ (Barnes' rule); `fmm`: θ of the acceptance r_A + r_B < θ·|z_A − z_B| "
+                            "(cell radii about the centres of mass); 0 gives the direct sum"},
             in_nbody(&GravitySettings::opening)));
   add(field(SceneKey{.key = "nbody.softening", .section = "nbody", .unit = "length", .range = kNonNegative,
                      .doc = "Plummer softening ε"},
@@ -512,6 +518,11 @@ std::vector<SceneKey> declare_scene_keys() {
                      // rounding only, and a resume reads the value from the scene saved with the run.
                      .hashed = false},
             in_nbody(&GravitySettings::simd)));
+  add(field(SceneKey{.key = "nbody.fmm_order", .section = "nbody", .range = kFmmOrder,
+                     .doc = "`fmm`: the expansion order p (multipoles to order p; the force error falls as θ^(p+1))",
+                     // Added after checkpoints existed: the default stays out of the scene hash.
+                     .unhashed_value = "3"},
+            in_nbody(&GravitySettings::fmm_order)));
   add(field(SceneKey{.key = "nbody.G", .section = "nbody", .unit = "length³/(mass·time²)", .range = kPositive,
                      .doc = "the gravitational constant, in the scene's units",
                      .default_doc = "`1` with `units = \"nbody\"`, `6.6743e-11` with `\"si\"`",

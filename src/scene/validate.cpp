@@ -67,6 +67,12 @@ class Checker {
   void nbody() const {
     if (!s_.nbody) return;
     const auto& g = *s_.nbody;
+    // The FMM stands on the linear octree of the global scheme; the paper's schemes and tree are Barnes–Hut's.
+    if (g.method == gravity::Method::Fmm && g.scheme != gravity::Scheme::Global)
+      fail("nbody.scheme", fmt::format("\"{}\" is a Barnes-Hut scheme; method \"fmm\" needs scheme = \"global\"",
+                                       gravity::to_string(g.scheme)));
+    if (g.method == gravity::Method::Fmm && g.tree != gravity::Tree::Linear)
+      fail("nbody.tree", "method \"fmm\" walks the linear octree: needs tree = \"linear\"");
     if (g.tree == gravity::Tree::Linear && g.scheme != gravity::Scheme::Global)
       fail("nbody.tree", fmt::format("\"linear\" needs nbody.scheme = \"global\" (the paper's scheme \"{}\" walks the "
                                      "paper's tree)",

@@ -216,6 +216,42 @@ TEST_F(BenchCli, BhLambdaQuick) {
   expect_png(d / "bh-lambda.png");
 }
 
+// The FMM dimension of bh-scale: its rows beside Barnes-Hut's, the error
+// falling with the order, and the same errors for 1 and 2 threads (the
+// results are bit-identical; the times are never compared).
+TEST_F(BenchCli, BhScaleQuickWithFmm) {
+  const auto d = dir_ / "bh-scale";
+  const Result r = swirl("bench bh-scale --quick --threads 1,2 --multipoles quadrupole --criteria barnes "
+                         "--fmm-orders 2,4 --fmm-buckets 32 --out " + d.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  // 2 sizes x (1 Barnes-Hut + 2 FMM orders) x 2 thread counts.
+  expect_csv(d / "bh-scale.csv",
+             {"particles", "precision", "method", "order", "multipole", "criterion", "walk", "opening", "bucket",
+              "group", "config", "threads", "repeats", "ms_per_evaluation", "cpu_ms_per_evaluation", "ms_build", "ms_walk",
+              "ns_per_particle",
+              "minteractions_per_second", "error_median", "error_p99", "interactions", "nodes_visited", "leaves",
+              "tree_bytes_per_particle", "total_bytes_per_particle", "sampled"},
+             12, {"ms_per_evaluation", "cpu_ms_per_evaluation", "error_median", "error_p99", "interactions",
+                  "nodes_visited"});
+  const Csv csv = read_csv(d / "bh-scale.csv");
+  std::map<std::string, std::string> error_at;  // size/method/order -> median error (1 thread)
+  for (const auto& row : csv.rows) {
+    const std::string key = row[0] + "/" + row[2] + "/" + row[3];
+    if (row[11] == "1") error_at[key] = row[19];
+  }
+  ASSERT_EQ(error_at.size(), 6u);
+  for (const auto& row : csv.rows) {
+    EXPECT_EQ(row[19], error_at[row[0] + "/" + row[2] + "/" + row[3]]) << "threads " << row[11];
+    if (row[2] == "fmm") {
+      EXPECT_EQ(row[8], "32");
+    }
+  }
+  for (const char* n : {"4096", "8192"})
+    EXPECT_LT(std::stod(error_at[std::string(n) + "/fmm/4"]), std::stod(error_at[std::string(n) + "/fmm/2"])) << n;
+  expect_records(d / "bh-scale.json", "bh-scale");
+  expect_png(d / "bh_scale.png");
+}
+
 TEST_F(BenchCli, BhPhasesQuick) {
   const Result r = bench("bh-phases");
   ASSERT_EQ(r.status, 0) << r.err;

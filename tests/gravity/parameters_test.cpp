@@ -92,10 +92,11 @@ TEST(ParametersTest, TreeMultipoleAndCriterionNamesRoundTrip) {
 
 TEST(ParametersTest, UnknownSchemeOrMethodListsTheAllowedNames) {
   expect_invalid([] { (void)parse_scheme("quadtree"); }, {"quadtree", "\"subdomain\"", "\"subtree\"", "\"global\""});
-  expect_invalid([] { (void)parse_method("fmm"); }, {"fmm", "\"direct\"", "\"barnes_hut\""});
+  expect_invalid([] { (void)parse_method("p3m"); }, {"p3m", "\"direct\"", "\"barnes_hut\"", "\"fmm\""});
   for (Scheme s : testing::kSchemes) EXPECT_EQ(parse_scheme(to_string(s)), s);
   EXPECT_EQ(parse_method("direct"), Method::Direct);
   EXPECT_EQ(parse_method("barnes_hut"), Method::BarnesHut);
+  EXPECT_EQ(parse_method("fmm"), Method::Fmm);
 }
 
 TYPED_TEST(ParametersTest, NoParticlesOrBadShapesForInitialConditions) {

@@ -77,6 +77,16 @@ TEST(NbodyScene, ThePapersSplitsAreSceneKeys) {
   EXPECT_NE(error_of(kPlummer, {"nbody.subtree_parts=0"}).find("nbody.subtree_parts"), std::string::npos);
 }
 
+TEST(NbodyScene, TheFastMultipoleMethodIsAMethodWithAnOrder) {
+  const Scene s = parse_scene(kPlummer, "g.toml",
+                              std::vector<std::string>{"nbody.method=\"fmm\"", "nbody.scheme=\"global\"",
+                                                       "nbody.fmm_order=5"});
+  EXPECT_EQ(s.nbody->method, swirl::gravity::Method::Fmm);
+  EXPECT_EQ(s.nbody->fmm_order, 5u);
+  EXPECT_EQ(s.nbody->tree, swirl::gravity::Tree::Linear);
+  EXPECT_EQ(parse_scene(kPlummer, "g.toml").nbody->fmm_order, 3u);
+}
+
 TEST(NbodyScene, ModelsAreMovedByOffsetAndVelocity) {
   const Scene s = parse_scene(kPlummer + R"(
 [[particles]]
@@ -109,8 +119,16 @@ TEST(NbodyScene, BadGravityInputIsRefusedClearly) {
   EXPECT_EQ(error_of(kPlummer, {"particles.0.count=0"}), "g.toml: particles[0].count: must be in [1, 2147483648], got 0");
   EXPECT_EQ(error_of(kPlummer, {"nbody.scheme=\"octree\""}),
             "g.toml: nbody.scheme: unknown scheme 'octree' (allowed: 'subdomain', 'subtree', 'global')");
-  EXPECT_EQ(error_of(kPlummer, {"nbody.method=\"fmm\""}),
-            "g.toml: nbody.method: unknown method 'fmm' (allowed: 'direct', 'barnes_hut')");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.method=\"pm\""}),
+            "g.toml: nbody.method: unknown method 'pm' (allowed: 'direct', 'barnes_hut', 'fmm')");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.method=\"fmm\"", "nbody.fmm_order=6"}),
+            "g.toml: nbody.fmm_order: must be in [2, 5], got 6");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.method=\"fmm\"", "nbody.fmm_order=1"}),
+            "g.toml: nbody.fmm_order: must be in [2, 5], got 1");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.method=\"fmm\"", "nbody.scheme=\"subtree\""}),
+            "g.toml: nbody.scheme: \"subtree\" is a Barnes-Hut scheme; method \"fmm\" needs scheme = \"global\"");
+  EXPECT_EQ(error_of(kPlummer, {"nbody.method=\"fmm\"", "nbody.scheme=\"global\"", "nbody.tree=\"paper\""}),
+            "g.toml: nbody.tree: method \"fmm\" walks the linear octree: needs tree = \"linear\"");
   EXPECT_EQ(error_of(kPlummer, {"nbody.theta=0.5"}), "g.toml: nbody.theta: unknown key");
   EXPECT_EQ(error_of(kPlummer, {"nbody.opneing=0.5"}), "g.toml: nbody.opneing: unknown key (did you mean 'opening'?)");
   EXPECT_NE(error_of(kPlummer + "[box]\nmin = [-5, -5, -5]\nmax = [5, 5, 5]\n").find("needs open space"), std::string::npos);

@@ -1,14 +1,15 @@
 // GravityForce<Real>: self-gravity as a solver (force/solver.hpp).
 //
-// Each evaluation computes the field of the particles (direct sum or
-// Barnes–Hut with the configured scheme), adds G·a_i to particles.acceleration
+// Each evaluation computes the field of the particles (direct sum,
+// Barnes–Hut with the configured scheme, or the fast multipole method), adds G·a_i to particles.acceleration
 // and writes G·φ_i into the field "potential", so W = ½ Σ m_i φ_i comes from
 // the same walk as the force. The tree codes work in G = 1; G scales the result
 // (1 in N-body units, 6.674e-11 m³ kg⁻¹ s⁻² in SI: scene key simulation.units).
 // With ctx.timers the time is recorded as "forces.tree_build" and "forces.walk".
 //
-// The default (global scheme, linear tree, settings.reorder) asks for the
-// simulation's particle order and builds the linear octree as a view of it
+// The default (global scheme, linear tree, settings.reorder), and the FMM with
+// settings.reorder, ask for the simulation's particle order and build the
+// linear octree as a view of it
 // (gravity/linear_octree.hpp: its nodes are prefixes of the order's sorted
 // Morton keys); it never moves a particle. Every other choice — the paper's
 // tree and schemes, reorder = false, an evaluation without an order — builds
@@ -23,7 +24,8 @@
 //
 // With an active set in the context (block time steps) only the active
 // particles' acceleration and potential are computed and written (the linear
-// tree and the direct sum skip the others; the paper's schemes compute all).
+// tree and the direct sum skip the others; the paper's schemes and the FMM
+// compute all: the FMM's mutual interactions do not separate by target).
 // The metric particle_force_evaluations counts the particles computed over
 // the run: the cost measure block steps are judged by.
 //
@@ -37,6 +39,7 @@
 #include "swirl/force/solver.hpp"
 #include "swirl/gravity/barnes_hut.hpp"
 #include "swirl/gravity/field.hpp"
+#include "swirl/gravity/fmm.hpp"
 #include "swirl/gravity/settings.hpp"
 
 namespace swirl::gravity {
@@ -85,6 +88,7 @@ class GravityForce final : public Solver<Real> {
   GravitySettings settings_;
   SelfGravityOptions options_;
   BarnesHut<Real> tree_;
+  Fmm<Real> fmm_;
   GravityField<Real> field_;
   GravityStats stats_;
   double nodes_sum_ = 0;  // Σ mean_nodes_visited over evaluations (the summary's mean)

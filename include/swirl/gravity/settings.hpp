@@ -21,8 +21,10 @@
 
 namespace swirl::gravity {
 
-// How the force is computed: the O(N²) reference or the paper's octree.
-enum class Method { Direct, BarnesHut };
+// How the force is computed: the O(N²) reference, the paper's octree
+// (Barnes–Hut), or the fast multipole method (fmm.hpp: cell–cell expansions
+// of order fmm_order with a dual tree walk, on the linear octree).
+enum class Method { Direct, BarnesHut, Fmm };
 
 // How the Barnes–Hut work is split (Demiroz et al. 2011, section 4):
 //   subdomain  4.1  Morton runs of ≤ subdomain_size particles, one local tree each;
@@ -78,7 +80,8 @@ enum class SubtreeSplit { Units, Parts };
 enum class UpperNodes { Opened, Clusters };
 
 // The names scenes, messages and options use: the only place they are spelt.
-inline constexpr std::array<EnumName<Method>, 2> kMethodNames{{{"direct", Method::Direct}, {"barnes_hut", Method::BarnesHut}}};
+inline constexpr std::array<EnumName<Method>, 3> kMethodNames{
+    {{"direct", Method::Direct}, {"barnes_hut", Method::BarnesHut}, {"fmm", Method::Fmm}}};
 inline constexpr std::array<EnumName<Scheme>, 3> kSchemeNames{
     {{"subdomain", Scheme::Subdomain}, {"subtree", Scheme::Subtree}, {"global", Scheme::Global}}};
 inline constexpr std::array<EnumName<Tree>, 2> kTreeNames{{{"paper", Tree::Paper}, {"linear", Tree::Linear}}};
@@ -102,7 +105,7 @@ std::string_view to_string(Walk walk);
 std::string_view to_string(SubdomainSplit split);
 std::string_view to_string(SubtreeSplit split);
 std::string_view to_string(UpperNodes upper);
-// Parse "direct" | "barnes_hut" and "subdomain" | "subtree" | "global"; an
+// Parse "direct" | "barnes_hut" | "fmm" and "subdomain" | "subtree" | "global"; an
 // unknown name throws std::invalid_argument listing the allowed ones.
 Method parse_method(std::string_view name);
 Scheme parse_scheme(std::string_view name);
@@ -139,6 +142,8 @@ struct GravitySettings {
   bool reorder = true;
   // λ of section 2 (θ of Barnes' rule for the linear tree's default criterion): a node whose size / distance(particle, centre of mass) < λ
   // is used as one particle, otherwise it is opened. 0 gives the direct sum.
+  // Method::Fmm: θ of the multipole acceptance r_A + r_B < θ |z_A − z_B|
+  // (cell radii about the centres of mass, fmm.hpp); 0 gives the direct sum.
   double opening = 0.5;
   // Plummer softening ε: forces use |r|² + ε² in place of |r|².
   double softening = 0.01;
@@ -152,6 +157,11 @@ struct GravitySettings {
   // thread count, so that results do not depend on the threads).
   std::size_t subtree_parts = 8;
   UpperNodes upper_nodes = UpperNodes::Opened;
+  // Method::Fmm: the expansion order p ∈ [2, 5] (multipoles to order p, the
+  // force's terms to total order p; its error falls as θ^{p+1}). The linear
+  // octree's bucket_size and reorder apply too; scheme, tree, multipole,
+  // criterion, walk, group_size and simd are Barnes–Hut's and ignored.
+  unsigned fmm_order = 3;
 };
 
 // Throws std::invalid_argument if a parameter is outside its range.
