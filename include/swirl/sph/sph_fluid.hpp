@@ -316,11 +316,20 @@ class SphFluid final : public Solver<Real> {
     used_grid_ = true;
     lists_ = {};
     if (!kernel_) kernel_.emplace(params_.kernel, Real(params_.smoothing_length));
+    if (!(alpha_cap_ > 0) && !p.empty()) {
+      // The cap of α: twice the factor of a full lattice neighbourhood at the
+      // spacing s = (m/ρ0)^⅓ of the largest mass (scenes' fluids have one
+      // mass; the largest, unlike the first, does not depend on the order).
+      double m = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) m = std::max(m, double(p.mass[i]));
+      const double s = std::cbrt(m / params_.rest_density);
+      alpha_cap_ = kAlphaCapFactor * dfsph_lattice_factor(*kernel_, m, s);
+    }
     alpha_.resize(p.size());
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.density");
-      pairs = dfsph_density_and_factor(grid_, p, *kernel_, ctx.block_size, alpha_.data());
+      pairs = dfsph_density_and_factor(grid_, p, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_));
     }
     mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
     count_evaluation();
@@ -419,6 +428,8 @@ class SphFluid final : public Solver<Real> {
   GridScratch<Real> scratch_;
   std::optional<DfsphKernel<Real>> kernel_;  // DFSPH: built at the first evaluation
   AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
+  double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
+  static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
 
   double mean_neighbours_ = 0;
