@@ -37,6 +37,8 @@ constexpr std::span<const EnumName<sph::NegativePressure>> names_of(sph::Negativ
 constexpr std::span<const EnumName<sph::NeighbourSearch>> names_of(sph::NeighbourSearch) {
   return sph::kNeighbourSearchNames;
 }
+constexpr std::span<const EnumName<sph::SphMethod>> names_of(sph::SphMethod) { return sph::kSphMethodNames; }
+constexpr std::span<const EnumName<sph::SphKernel>> names_of(sph::SphKernel) { return sph::kSphKernelNames; }
 constexpr std::span<const EnumName<spatial::CellOrder>> names_of(spatial::CellOrder) { return spatial::kCellOrderNames; }
 constexpr std::span<const EnumName<spatial::DuplicateCheck>> names_of(spatial::DuplicateCheck) {
   return spatial::kCheckPlacementNames;
@@ -351,6 +353,47 @@ std::vector<SceneKey> declare_scene_keys() {
                .default_doc = "–", .custom_read = true,
                // Only a way to give h, which is hashed.
                .get = [](const Scene&) -> std::optional<KeyValue> { return std::nullopt; }});
+  add(field(SceneKey{.key = "sph.method", .section = "sph", .noun = "SPH method",
+                     .doc = "`\"wcsph\"` (the thesis's weakly compressible fluid, p = c²(ρ − ρ0)) or `\"dfsph\"` "
+                            "(divergence-free SPH, Bender & Koschier 2015/2017: a constant-density and a "
+                            "divergence-free solve per step, iterated to `sph.dfsph.*` tolerances; needs the grid "
+                            "search); docs/sph.md",
+                     .unhashed_value = "wcsph"},
+            in_sph(&sph::SphParameters::method)));
+  add(field(SceneKey{.key = "sph.kernel", .section = "sph", .noun = "kernel",
+                     .doc = "DFSPH's kernels: `\"cubic_spline\"` (Monaghan 1992, W and its own gradient) or "
+                            "`\"thesis\"` (W_poly6 density, ∇W_spiky gradients); the thesis's solver takes "
+                            "`\"thesis\"` only",
+                     .default_doc = "`\"cubic_spline\"` with `method = \"dfsph\"`, else `\"thesis\"`",
+                     .unhashed_value = "thesis",
+                     .context_default = [](const Scene& s) {
+                       const bool dfsph = s.sph && s.sph->method == sph::SphMethod::Dfsph;
+                       return to_value(dfsph ? sph::SphKernel::CubicSpline : sph::SphKernel::Thesis);
+                     }},
+            in_sph(&sph::SphParameters::kernel)));
+  const auto in_dfsph = [](auto member) {
+    return [member](auto& s) { return s.sph && s.sph->method == sph::SphMethod::Dfsph ? &(s.sph->dfsph.*member) : nullptr; };
+  };
+  add(field(SceneKey{.key = "sph.dfsph.density_tolerance", .section = "sph", .range = Range{0, 1, true, false},
+                     .doc = "η: the constant-density solve iterates until the average compression "
+                            "max(ρ* − ρ0, 0)/ρ0 is at most this (5e-4 = 0.05 %)",
+                     .default_doc = "`5e-4` (with `method = \"dfsph\"`)"},
+            in_dfsph(&sph::DfsphOptions::density_tolerance)));
+  add(field(SceneKey{.key = "sph.dfsph.divergence_tolerance", .section = "sph", .range = Range{0, 1, true, false},
+                     .doc = "η_v: the divergence-free solve iterates until the average max(Dρ/Dt, 0)·Δt/ρ0 is at "
+                            "most this",
+                     .default_doc = "`1e-3` (with `method = \"dfsph\"`)"},
+            in_dfsph(&sph::DfsphOptions::divergence_tolerance)));
+  add(field(SceneKey{.key = "sph.dfsph.max_iterations", .section = "sph", .range = Range{1, 1e6},
+                     .doc = "the cap of either solve; a solve that reaches it above its tolerance stops the run "
+                            "(blow-up \"solver did not converge\")",
+                     .default_doc = "`100` (with `method = \"dfsph\"`)"},
+            in_dfsph(&sph::DfsphOptions::max_iterations)));
+  add(field(SceneKey{.key = "sph.dfsph.cfl", .section = "sph", .range = kFraction,
+                     .doc = "C of DFSPH's CFL condition Δt ≤ C·h/\\|v\\|max (no sound speed: the fluid is "
+                            "incompressible; 0.2·h ≈ 0.4 spacings at h ≈ 2 spacings)",
+                     .default_doc = "`0.2` (with `method = \"dfsph\"`)"},
+            in_dfsph(&sph::DfsphOptions::cfl)));
   add(field(SceneKey{.key = "sph.rest_density", .section = "sph", .unit = "kg/m³", .range = kPositive, .doc = "ρ0"},
             in_sph(&sph::SphParameters::rest_density)));
   add(field(SceneKey{.key = "sph.sound_speed", .section = "sph", .unit = "m/s", .range = kPositive,

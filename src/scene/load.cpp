@@ -366,10 +366,15 @@ void read_sph(const Table& top, Scene& s) {
   hash.only(known_keys("sph.hash"));
   const Table grid = t.table("grid");
   grid.only(known_keys("sph.grid"));
+  const Table dfsph = t.table("dfsph");
+  dfsph.only(known_keys("sph.dfsph"));
   s.sph.emplace();
   t.read_scene_keys(s);
   hash.read_scene_keys(s);
   grid.read_scene_keys(s);
+  if (t.find("dfsph") && s.sph->method != sph::SphMethod::Dfsph)
+    t.fail("dfsph", "the [sph.dfsph] settings need sph.method = \"dfsph\"");
+  dfsph.read_scene_keys(s);
   const bool has_h = t.find("smoothing_length") != nullptr, has_k = t.find("neighbours") != nullptr;
   if (has_h && has_k) t.fail("neighbours", fmt::format("cannot be given together with {}", t.key("smoothing_length")));
   if (has_h) {
@@ -573,7 +578,9 @@ void read_particles(const Table& top, Scene& s) {
       if (!s.sph) t.fail("kind", "a 'fluid_block' needs an [sph] section (its mass comes from sph.rest_density)");
       if (s.sph->smoothing_length / lattice.spacing > 1000)
         t.fail("spacing", fmt::format("is over 1000 times smaller than sph.smoothing_length = {}", s.sph->smoothing_length));
-      lattice.mass = sph::lattice_mass_for_density(lattice.spacing, s.sph->smoothing_length, s.sph->rest_density);
+      lattice.mass = sph::lattice_mass_for_density(lattice.spacing, s.sph->smoothing_length, s.sph->rest_density,
+                                                   s.sph->method == sph::SphMethod::Dfsph ? s.sph->kernel
+                                                                                          : sph::SphKernel::Thesis);
     }
     s.sources.push_back(std::move(source));
   }

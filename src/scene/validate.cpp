@@ -88,6 +88,19 @@ class Checker {
   }
 
   void sph() const {
+    if (!s_.sph) return;
+    const sph::SphParameters& f = *s_.sph;
+    if (f.method == sph::SphMethod::Dfsph) {
+      if (f.neighbour_search != sph::NeighbourSearch::Grid)
+        fail("sph.neighbour_search", "\"dfsph\" runs its solves on the sorted grid only; use \"grid\"");
+      if (f.gradient_correction)
+        fail("sph.gradient_correction", "corrects the thesis's pressure force, which \"dfsph\" does not use");
+      if (s_.time_steps == TimeSteps::Block)
+        fail("simulation.time_steps", "\"block\" cannot be combined with sph.method = \"dfsph\"");
+    } else if (f.kernel != sph::SphKernel::Thesis) {
+      fail("sph.kernel", fmt::format("\"{}\" needs sph.method = \"dfsph\" (the thesis's solver runs its own kernels)",
+                                     enum_name<sph::SphKernel>(sph::kSphKernelNames, f.kernel)));
+    }
     const double keys = dense_cell_table_keys(s_);
     if (keys > 0x1p31)
       fail("sph.grid.table",

@@ -168,6 +168,7 @@ class DiagnosticsLog final : public Observer<Real> {
     header += ",momentum_x,momentum_y,momentum_z,angular_momentum_x,angular_momentum_y,angular_momentum_z";
     for (const auto& s : sim.solvers())
       for (const auto& c : s->diagnostic_columns()) header += "," + c;
+    for (const auto& c : sim.stepper().diagnostic_columns()) header += "," + c;
     if (adaptive_) header += ",step,dt_min,dt_max,dt_next,limited_by";
     text_ = header + "\n";
   }
@@ -233,6 +234,7 @@ class DiagnosticsLog final : public Observer<Real> {
     }
     row.insert(row.end(), {m.momentum[0], m.momentum[1], m.momentum[2], m.angular[0], m.angular[1], m.angular[2]});
     for (const auto& s : sim.solvers()) s->add_diagnostics(p, block_size_, row);
+    sim.stepper().add_diagnostics(row);
     for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
     if (adaptive_) {
       const bool stepped = frame_dt_max_ > 0;

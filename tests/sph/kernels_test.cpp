@@ -73,6 +73,42 @@ TYPED_TEST(KernelTest, GradientsMatchFiniteDifferences) {
   }
 }
 
+TYPED_TEST(KernelTest, CubicSplineIntegratesToOne) {
+  using Real = TypeParam;
+  for (double h : {0.01, 0.5, 3.0}) {
+    const CubicSpline<Real> w{Real(h)};
+    // q = ½ falls on a Simpson node (interval 1000 of 2000), so the kink of
+    // the second derivative there costs no accuracy.
+    EXPECT_NEAR(ball_integral([&](double r) { return double(w(Real(r))); }, h), 1.0, tol<Real>()) << h;
+  }
+  // Monaghan's value at the centre, 1/(π ℓ³) with ℓ = h/2.
+  const double h = 0.4, l = h / 2;
+  EXPECT_NEAR(double(CubicSpline<Real>(Real(h))(Real(0))), 1 / (std::numbers::pi * l * l * l),
+              (std::is_same_v<Real, float> ? 1e-6 : 1e-13) / (l * l * l));
+}
+
+TYPED_TEST(KernelTest, CubicSplineGradientMatchesFiniteDifferences) {
+  using Real = TypeParam;
+  const double h = 0.7;
+  const CubicSpline<Real> w{Real(h)};
+  const double d = std::is_same_v<Real, float> ? 1e-3 : 1e-6;
+  const double rel = std::is_same_v<Real, float> ? 2e-2 : 1e-6;
+  // Both branches, and near the joint (q = 0.5 at r = 0.35) from either side.
+  for (double r : {0.03, 0.1, 0.2, 0.34, 0.36, 0.5, 0.65}) {
+    const double fd = (double(w(Real(r + d))) - double(w(Real(r - d)))) / (2 * d);
+    EXPECT_NEAR(double(w.gradient_factor(Real(r))) * r, fd, rel * std::abs(fd)) << r;
+    EXPECT_LT(w.gradient_factor(Real(r)), Real(0)) << r;  // W decreases outward
+  }
+  // Continuous at the joint: the two branches agree to rounding.
+  const Real joint = Real(0.35);
+  EXPECT_NEAR(double(w.gradient_factor(joint)), double(w.gradient_factor(joint * (Real(1) + Real(1e-6)))),
+              1e-4 * std::abs(double(w.gradient_factor(joint))));
+  EXPECT_EQ(w.gradient_factor(Real(0)), Real(0));
+  EXPECT_EQ(w(Real(h)), Real(0));
+  EXPECT_EQ(w.gradient_factor(Real(h)), Real(0));
+  EXPECT_GT(w(Real(0.99 * h)), Real(0));
+}
+
 TYPED_TEST(KernelTest, AllVanishAtAndBeyondTheSupport) {
   using Real = TypeParam;
   const Real h = Real(0.3);

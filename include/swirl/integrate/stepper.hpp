@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
@@ -74,6 +75,9 @@ struct StepOutcome {
   // the solvers' limits in place of the whole step; 0: the step is not divided.
   double finest_dt = 0;
   std::string finest_fix;  // what relaxes it, for the guard's message (e.g. "a larger max_bin")
+  // An iterative solver that stopped at its cap above its tolerance: what and
+  // by how much, and the fix (the guard reports it as "solver did not converge").
+  std::string not_converged;
 };
 
 template <class Real>
@@ -90,6 +94,10 @@ class Stepper {
   virtual StepOutcome advance(ParticleSet<Real>& particles, Forces& forces, const StepRequest& request) = 0;
   // Summary figures over the run so far (e.g. sub-steps taken).
   virtual void add_metrics(NamedValues& /*out*/) const {}
+  // Its columns of the per-frame diagnostics log and their values (e.g. a
+  // pressure solver's iterations), after the solvers' columns.
+  virtual std::vector<std::string> diagnostic_columns() const { return {}; }
+  virtual void add_diagnostics(std::vector<double>& /*row*/) const {}
   // State across a checkpoint beyond the particle fields (names prefixed with name() + ".").
   virtual void save_state(NamedValues& /*out*/) const {}
   virtual void load_state(const NamedValues& /*values*/) {}

@@ -10,6 +10,8 @@
 //   TimeStep      a fixed Δt exceeds a time-step condition (a solver's add_limits())
 //                 of the state the next step starts from;
 //   StepCollapse  an adaptive Δt fell below its floor (dt_min);
+//   NotConverged  an iterative pressure solver (DFSPH, sph/dfsph_stepper.hpp)
+//                 reached its iteration cap above its tolerance;
 //   EnergyDrift   the relative energy error of a run whose every force conserves
 //                 energy passed simulation.max_energy_error (checked at each
 //                 diagnostics row, i.e. each output time; sim/run.hpp).
@@ -25,10 +27,11 @@
 
 namespace swirl {
 
-enum class BlowUpCause { NonFinite, LeftDomain, TimeStep, StepCollapse, EnergyDrift };
-inline constexpr std::size_t kBlowUpCauses = 5;
+enum class BlowUpCause { NonFinite, LeftDomain, TimeStep, StepCollapse, EnergyDrift, NotConverged };
+inline constexpr std::size_t kBlowUpCauses = 6;
 
-// "non-finite state", "left the domain", "time-step condition", "time step collapsed", "energy error".
+// "non-finite state", "left the domain", "time-step condition", "time step collapsed", "energy error",
+// "solver did not converge".
 inline std::string_view to_string(BlowUpCause cause) {
   switch (cause) {
     case BlowUpCause::NonFinite: return "non-finite state";
@@ -36,6 +39,7 @@ inline std::string_view to_string(BlowUpCause cause) {
     case BlowUpCause::TimeStep: return "time-step condition";
     case BlowUpCause::StepCollapse: return "time step collapsed";
     case BlowUpCause::EnergyDrift: return "energy error";
+    case BlowUpCause::NotConverged: return "solver did not converge";
   }
   return "?";
 }

@@ -1,5 +1,6 @@
 // Building the Simulation a scene describes: its particles, its stepper (with
-// the box's walls, or open space; block time steps with simulation.time_steps)
+// the box's walls, or open space; block time steps with simulation.time_steps;
+// DFSPH's stepper with sph.method = "dfsph")
 // and its solvers, each made from its own
 // section of the scene — SPH from [sph], self-gravity from [nbody] (G from
 // simulation.units / nbody.G), a uniform field from forces.gravity, a drag
@@ -18,6 +19,7 @@
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/scene.hpp"
 #include "swirl/sim/simulation.hpp"
+#include "swirl/sph/dfsph_stepper.hpp"
 #include "swirl/sph/sph_fluid.hpp"
 
 namespace swirl::sim {
@@ -34,15 +36,19 @@ Simulation<Real> build_simulation(const scene::Scene& scene) {
   std::optional<boundary::BoxCollision<Real>> box;
   if (scene.walls) box = boundary::BoxCollision<Real>{scene.box.template cast<Real>(), Real(scene.restitution)};
   std::unique_ptr<integrate::Stepper<Real>> stepper;
-  if (scene.time_steps == scene::TimeSteps::Block)
+  std::unique_ptr<sph::SphFluid<Real>> fluid;
+  if (scene.sph)
+    fluid = std::make_unique<sph::SphFluid<Real>>(
+        *scene.sph, sph::StepConditions{scene.cfl, scene.force_factor, scene.viscous_factor});
+  if (fluid && fluid->dfsph())  // the stepper drives the fluid's solves; the simulation owns both
+    stepper = std::make_unique<sph::DfsphStepper<Real>>(*fluid, std::move(box));
+  else if (scene.time_steps == scene::TimeSteps::Block)
     stepper = std::make_unique<integrate::BlockStepper<Real>>(
         integrate::BlockStepOptions{scene.eta, scene.nbody->softening, int(scene.max_bin)});
   else
     stepper = std::make_unique<integrate::KickDriftStepper<Real>>(integrate::Method::VelocityVerlet, std::move(box));
   Simulation<Real> sim(scene::make_particles<Real>(scene), settings, std::move(stepper));
-  if (scene.sph)
-    sim.add_solver(std::make_unique<sph::SphFluid<Real>>(
-        *scene.sph, sph::StepConditions{scene.cfl, scene.force_factor, scene.viscous_factor}));
+  if (fluid) sim.add_solver(std::move(fluid));
   if (scene.nbody)
     sim.add_solver(std::make_unique<gravity::GravityForce<Real>>(
         *scene.nbody, gravity::SelfGravityOptions{scene.gravitational_constant, scene.eta}));

@@ -207,6 +207,8 @@ class Simulation {
     if (scan_.non_finite != kNoParticle) throw_non_finite(scan_.non_finite);
     if (!checks) return;
     if (outcome.escape.found) report(BlowUpCause::LeftDomain, escape_message(outcome.escape));
+    if (!outcome.not_converged.empty())
+      report(BlowUpCause::NotConverged, fmt::format("{}: blow-up: {}", where(), outcome.not_converged));
     const StepLimit& tight = tightest();
     if (outcome.finest_dt > 0) {  // divided steps: the finest sub-step against the tightest limit
       if (outcome.finest_dt > tight.dt * (1 + 1e-12))

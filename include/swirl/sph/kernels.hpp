@@ -1,5 +1,5 @@
 // The smoothing kernels of Müller et al. 2003, as the thesis uses them
-// (section 2.1.1). Each is a small evaluator built once for a support radius h
+// (section 2.1.1), and the cubic spline of Monaghan 1992 (DFSPH's kernel). Each is a small evaluator built once for a support radius h
 // (m); all vanish for r ≥ h. Units: W in 1/m³, ∇W in 1/m⁴, ∇²W in 1/m⁵.
 #pragma once
 
@@ -83,6 +83,42 @@ struct Viscosity {
 
  private:
   static Real pow6(Real x) { const Real x3 = x * x * x; return x3 * x3; }
+};
+
+// The cubic spline (Monaghan 1992, "Smoothed particle hydrodynamics", eq. 2.6
+// with support 2ℓ), written for the support radius h = 2ℓ like the kernels
+// above, q = r/h:
+//   W(r, h) = k · (6q³ − 6q² + 1)   for 0 ≤ q ≤ ½,    k = 8 / (π h³)
+//           = k · 2 (1 − q)³        for ½ < q < 1
+// dW/dr    = (k/h) · 6 (3q² − 2q)   for q ≤ ½
+//          = −(k/h) · 6 (1 − q)²    for ½ < q < 1
+// ∇W = dW/dr · r⃗ / r (r⃗ = x_i − x_j), 0 at r = 0 (dW/dr vanishes there).
+// W and its first derivative are continuous at q = ½ and vanish smoothly at
+// q = 1, and unlike W_spiky its gradient is the derivative of the density
+// kernel itself, which DFSPH's factor α and its density prediction assume.
+template <class Real>
+struct CubicSpline {
+  explicit CubicSpline(Real h_)
+      : h(h_), inv_h(Real(1) / h_), norm(Real(8) / (std::numbers::pi_v<Real> * h_ * h_ * h_)),
+        grad_norm(Real(48) / (std::numbers::pi_v<Real> * h_ * h_ * h_ * h_)) {}
+
+  Real operator()(Real r) const {
+    const Real q = r * inv_h;
+    if (q >= Real(1)) return Real(0);
+    if (q <= Real(0.5)) return norm * (Real(6) * q * q * (q - Real(1)) + Real(1));
+    const Real d = Real(1) - q;
+    return norm * Real(2) * d * d * d;
+  }
+  // ∇W = gradient_factor(r) · r⃗, for r = |r⃗| (grad_norm = 6k/h).
+  Real gradient_factor(Real r) const {
+    const Real q = r * inv_h;
+    if (q >= Real(1) || r <= Real(0)) return Real(0);
+    if (q <= Real(0.5)) return grad_norm * (Real(3) * q - Real(2)) * inv_h;  // 6k/h·(3q² − 2q)/r, r = q·h
+    const Real d = Real(1) - q;
+    return -grad_norm * d * d / r;
+  }
+
+  Real h, inv_h, norm, grad_norm;
 };
 
 }  // namespace swirl::sph

@@ -7,22 +7,29 @@
 #include <stdexcept>
 
 #include "swirl/sph/kernels.hpp"
+#include "swirl/sph/parameters.hpp"
 
 namespace swirl::sph {
 
 // The mass m that makes the SPH density of an interior particle of a simple
 // cubic lattice of spacing s exactly ρ0: m = ρ0 / Σ_n W_poly6(|n|·s, h), the sum
 // over all lattice vectors n (the particle itself included) within h. A block
-// made with it starts at rest with zero pressure inside.
-inline double lattice_mass_for_density(double spacing, double h, double rest_density) {
+// made with it starts at rest with zero pressure inside. With the cubic spline
+// (DFSPH's kernel, sph.kernel) the sum is of that kernel's W.
+inline double lattice_mass_for_density(double spacing, double h, double rest_density,
+                                       SphKernel kernel = SphKernel::Thesis) {
   if (!(spacing > 0) || !(h > 0) || !(rest_density > 0) || h / spacing > 1000)
     throw std::invalid_argument("lattice mass: need spacing > 0, h > 0, ρ0 > 0 and h/spacing ≤ 1000");
   const Poly6<double> w(h);
+  const CubicSpline<double> cubic(h);
   const int reach = static_cast<int>(std::ceil(h / spacing));
   double sum = 0;
   for (int i = -reach; i <= reach; ++i)
     for (int j = -reach; j <= reach; ++j)
-      for (int k = -reach; k <= reach; ++k) sum += w(spacing * spacing * double(i * i + j * j + k * k));
+      for (int k = -reach; k <= reach; ++k) {
+        const double r2 = spacing * spacing * double(i * i + j * j + k * k);
+        sum += kernel == SphKernel::CubicSpline ? cubic(std::sqrt(r2)) : w(r2);
+      }
   return rest_density / sum;
 }
 

@@ -252,6 +252,30 @@ struct SphLaws {
   }
 };
 
+// DFSPH's kernels (sph.kernel; sph/dfsph_passes.hpp), scalar:
+//   W(r)  for the density           ρ_i = Σ_j m_j W(r_ij)
+//   ∇W_ij = gradient(r) · r⃗_ij      (r⃗_ij = x_i − x_j)
+// "cubic_spline": Monaghan's W and its own gradient (CubicSpline);
+// "thesis": W_poly6 and ∇W_spiky, the thesis's pair (the gradient is not the
+// density kernel's, so DFSPH's density prediction is only approximately the
+// density that follows; kept for comparison with the thesis's solver).
+template <class Real>
+struct DfsphKernel {
+  DfsphKernel(SphKernel kind, Real h_)
+      : h(h_), h2(h_ * h_), cubic(kind == SphKernel::CubicSpline), poly6(h_), spiky(h_), spline(h_) {}
+
+  // W at distance r (r² given as well: poly6 takes it).
+  Real w(Real r2, Real r) const { return cubic ? spline(r) : poly6(r2); }
+  // The factor of r⃗_ij; 0 at r = 0.
+  Real gradient(Real r) const { return cubic ? spline.gradient_factor(r) : spiky.gradient_factor(r); }
+
+  Real h, h2;
+  bool cubic;
+  Poly6<Real> poly6;
+  Spiky<Real> spiky;
+  CubicSpline<Real> spline;
+};
+
 }  // namespace swirl::sph
 
 #undef SWIRL_LAW_INLINE

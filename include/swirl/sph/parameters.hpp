@@ -31,13 +31,37 @@ enum class NeighbourSearch {
   Hash,  // the thesis's spatial hash with CSR interaction lists (spatial/spatial_hash.hpp)
 };
 
-// The names scenes use (sph.pressure, sph.negative_pressure, sph.neighbour_search).
+// The pressure solver (sph.method).
+enum class SphMethod {
+  Wcsph,  // the thesis's weakly compressible fluid: p = c² (ρ − ρ0), explicit forces (sph_fluid.hpp)
+  Dfsph,  // divergence-free SPH (Bender & Koschier 2015, 2017): iterative solves in the stepper (sph/dfsph_stepper.hpp)
+};
+
+// The smoothing kernels of DFSPH's passes (sph.kernel).
+enum class SphKernel {
+  Thesis,       // W_poly6 for density, ∇W_spiky for gradients (Müller et al. 2003, the thesis's set)
+  CubicSpline,  // Monaghan 1992's cubic spline, W and its own gradient (sph/kernels.hpp)
+};
+
+// The names scenes use (sph.pressure, sph.negative_pressure, sph.neighbour_search, sph.method, sph.kernel).
+inline constexpr std::array<EnumName<SphMethod>, 2> kSphMethodNames{
+    {{"wcsph", SphMethod::Wcsph}, {"dfsph", SphMethod::Dfsph}}};
+inline constexpr std::array<EnumName<SphKernel>, 2> kSphKernelNames{
+    {{"thesis", SphKernel::Thesis}, {"cubic_spline", SphKernel::CubicSpline}}};
 inline constexpr std::array<EnumName<PressureForm>, 2> kPressureFormNames{
     {{"thesis", PressureForm::Thesis}, {"consistent", PressureForm::Consistent}}};
 inline constexpr std::array<EnumName<NegativePressure>, 2> kNegativePressureNames{
     {{"keep", NegativePressure::Keep}, {"zero", NegativePressure::Zero}}};
 inline constexpr std::array<EnumName<NeighbourSearch>, 2> kNeighbourSearchNames{
     {{"grid", NeighbourSearch::Grid}, {"hash", NeighbourSearch::Hash}}};
+
+// The DFSPH solver's settings (sph.dfsph.*; sph/dfsph_stepper.hpp).
+struct DfsphOptions {
+  double density_tolerance = 5e-4;     // η: the average compression max(ρ* − ρ0, 0)/ρ0 the density solve stops below
+  double divergence_tolerance = 1e-3;  // η_v: the average max(Dρ/Dt, 0)·Δt/ρ0 the divergence solve stops below
+  std::uint32_t max_iterations = 100;  // of either solve; more is a blow-up ("solver did not converge")
+  double cfl = 0.2;                    // C: Δt ≤ C·h/|v|max (0.2·h ≈ 0.4 particle spacings at h ≈ 2 spacings)
+};
 
 struct SphParameters {
   double smoothing_length = 0;     // h, m (> 0): kernel support and hash cell length
@@ -57,6 +81,9 @@ struct SphParameters {
   spatial::CellOrder cell_order = spatial::CellOrder::Rows;  // grid: cell order (spatial/cell_order.hpp)
   double grid_skin = 0;            // grid: Verlet skin, m (≥ 0); 0 = sort every evaluation
   spatial::CellTable cell_table = spatial::CellTable::Auto;  // grid: dense or hashed cell lookup
+  SphMethod method = SphMethod::Wcsph;
+  SphKernel kernel = SphKernel::Thesis;  // DFSPH's kernels (the thesis's solver always uses its own set)
+  DfsphOptions dfsph;                    // method = Dfsph only
 };
 
 // The thesis's table size for n particles: 1.6·n, odd (24001 for 15000).

@@ -52,6 +52,15 @@
 // "tensile instability"). NegativePressure::Zero clamps it, as many graphics
 // codes do; the default keeps the thesis's equation.
 //
+// With sph.method = "dfsph" (divergence-free SPH, sph/dfsph_stepper.hpp) the
+// solver adds no pressure force: each evaluation computes ρ_i and the DFSPH
+// factor α_i (sph/dfsph_passes.hpp) on the grid, and the stepper, which owns
+// the pressure solves, calls the passes below (density_change,
+// pressure_velocity, add_viscosity) on the same grid view while the positions
+// stay put. Its warm starts are two internal particle fields (kKappaField,
+// kKappaVField), so reorders and checkpoints carry them. Its time-step
+// condition is a CFL without a sound speed: Δt ≤ C·h/|v|max (sph.dfsph.cfl).
+//
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
 // Every pass gathers into particle i only: deterministic for any thread count.
 #pragma once
@@ -72,6 +81,7 @@
 #include "swirl/core/phase_timers.hpp"
 #include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
+#include "swirl/sph/dfsph_passes.hpp"
 #include "swirl/sph/grid_passes.hpp"
 #include "swirl/sph/laws.hpp"
 #include "swirl/sph/parameters.hpp"
@@ -98,6 +108,23 @@ class SphFluid final : public Solver<Real> {
     if (!(params.rest_density > 0)) throw std::invalid_argument("SPH: rest density must be > 0");
     if (!(params.sound_speed > 0)) throw std::invalid_argument("SPH: sound speed must be > 0");
     if (!(params.viscosity >= 0)) throw std::invalid_argument("SPH: viscosity must be ≥ 0");
+    if (dfsph() && params.neighbour_search != NeighbourSearch::Grid)
+      throw std::invalid_argument("SPH: sph.method = \"dfsph\" needs sph.neighbour_search = \"grid\"");
+    if (!dfsph() && params.kernel != SphKernel::Thesis)
+      throw std::invalid_argument("SPH: sph.kernel = \"cubic_spline\" needs sph.method = \"dfsph\"");
+  }
+
+  // DFSPH's warm starts: the κ sums of the last constant-density and
+  // divergence-free solves (m²/s², κ = p/ρ), per particle.
+  static constexpr std::string_view kKappaField = "dfsph_kappa";
+  static constexpr std::string_view kKappaVField = "dfsph_kappa_v";
+
+  bool dfsph() const { return params_.method == SphMethod::Dfsph; }
+
+  void declare_fields(ParticleSet<Real>& p) override {
+    if (!dfsph()) return;
+    p.add_field(std::string(kKappaField), 1, FieldUse::Internal);
+    p.add_field(std::string(kKappaVField), 1, FieldUse::Internal);
   }
 
   std::string_view name() const override { return "sph"; }
@@ -110,6 +137,10 @@ class SphFluid final : public Solver<Real> {
   }
 
   void add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) override {
+    if (dfsph()) {
+      dfsph_evaluate(p, ctx);
+      return;
+    }
     if (params_.neighbour_search == NeighbourSearch::Grid && add_acceleration_grid(p, ctx)) return;
     add_acceleration_hash(p, ctx);
     count_evaluation();
@@ -119,7 +150,12 @@ class SphFluid final : public Solver<Real> {
 
   void add_limits(const StepScan& scan, std::size_t /*n*/, std::vector<StepLimit>& out) const override {
     const double h = params_.smoothing_length, speed = std::sqrt(scan.speed2), accel = std::sqrt(scan.accel2);
-    out.push_back({"cfl", conditions_.cfl * h / (params_.sound_speed + speed), scan.speed_at, speed, "|v|"});
+    if (dfsph()) {
+      // Incompressible: no sound speed; a particle moves at most C·h per step.
+      if (speed > 0) out.push_back({"cfl", params_.dfsph.cfl * h / speed, scan.speed_at, speed, "|v|"});
+    } else {
+      out.push_back({"cfl", conditions_.cfl * h / (params_.sound_speed + speed), scan.speed_at, speed, "|v|"});
+    }
     if (accel > 0) out.push_back({"force", conditions_.force_factor * std::sqrt(h / accel), scan.accel_at, accel, "|a|"});
     if (params_.viscosity > 0 && scan.density_at != kNoParticle)
       out.push_back({"viscous", conditions_.viscous_factor * h * h * scan.density / params_.viscosity, scan.density_at,
@@ -128,6 +164,10 @@ class SphFluid final : public Solver<Real> {
 
   LimitText explain(const StepLimit& l, std::string_view id) const override {
     const double h = params_.smoothing_length;
+    if (l.condition == "cfl" && dfsph())
+      return {fmt::format("DFSPH's CFL condition C·h/|v|max = {}·{:.3g}/{:.3g} = {:.6g} (|v|max = {:.3g} at particle id {})",
+                          params_.dfsph.cfl, h, l.value, l.dt, l.value, id),
+              "or a smaller sph.dfsph.cfl with dt = \"adaptive\""};
     if (l.condition == "cfl")
       return {fmt::format("the CFL condition C_cfl·h/(c + |v|max) = {}·{:.3g}/({:.3g} + {:.3g}) = {:.6g} "
                           "(|v|max = {:.3g} at particle id {})",
@@ -145,7 +185,24 @@ class SphFluid final : public Solver<Real> {
   }
 
   std::string advice() const override {
+    if (dfsph()) return "if the fluid is exploding, a smaller time step or tighter sph.dfsph tolerances";
     return "if the fluid is exploding, a larger smoothing length h or sound speed c";
+  }
+
+  // ---- DFSPH (sph/dfsph_stepper.hpp): passes on the last evaluation's grid ----
+  // Valid between an evaluation and the next position change.
+  const DfsphKernel<Real>& dfsph_kernel() const { return *kernel_; }
+  // α_i of the last evaluation (sorted order), for every particle.
+  const Real* factor() const { return alpha_.data(); }
+  void density_change(const ParticleSet<Real>& p, Real* out, std::size_t block_size) const {
+    dfsph_density_change(grid_, p, *kernel_, block_size, out);
+  }
+  void pressure_velocity(ParticleSet<Real>& p, const Real* k_over_rho, Real dt, std::size_t block_size) const {
+    dfsph_pressure_velocity(grid_, p, *kernel_, block_size, k_over_rho, dt);
+  }
+  // The non-pressure force of the fluid: the thesis's viscosity (eq. 2.10).
+  void add_viscosity(ParticleSet<Real>& p, std::size_t block_size) const {
+    if (params_.viscosity > 0) dfsph_add_viscosity(grid_, p, SphLaws<Real>(params_), block_size);
   }
 
   std::vector<std::string> diagnostic_columns() const override {
@@ -198,7 +255,7 @@ class SphFluid final : public Solver<Real> {
   // Bytes the solver keeps between evaluations (search structures, lists,
   // scratch), in all: add to the particle fields for the memory per particle.
   std::size_t scratch_bytes() const override {
-    return grid_.bytes() + scratch_.bytes() +
+    return grid_.bytes() + scratch_.bytes() + alpha_.capacity() * sizeof(Real) +
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
            lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
@@ -242,6 +299,40 @@ class SphFluid final : public Solver<Real> {
       grid_forces(grid_, p, k, ctx.block_size, scratch_, kernel_path());
     }
     return true;
+  }
+
+  // DFSPH's evaluation: the grid view, ρ and α; no force (the stepper's solves
+  // are the pressure, and it adds the viscosity once the velocities are final).
+  void dfsph_evaluate(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
+    if (!ctx.order) throw std::logic_error("DFSPH: needs the simulation's particle order");
+    {
+      PhaseScope phase(ctx, "forces.cells");
+      grid_.set_table(params_.cell_table);
+      if (!grid_.view(*ctx.order, ctx.block_size))
+        throw std::runtime_error(
+            "DFSPH: the particles spread over more than 2^21 grid cells along an axis, which the grid search (the "
+            "only one DFSPH has) cannot index; a larger smoothing length or a smaller domain");
+    }
+    used_grid_ = true;
+    lists_ = {};
+    if (!kernel_) kernel_.emplace(params_.kernel, Real(params_.smoothing_length));
+    if (!(alpha_cap_ > 0) && !p.empty()) {
+      // The cap of α: twice the factor of a full lattice neighbourhood at the
+      // spacing s = (m/ρ0)^⅓ of the largest mass (scenes' fluids have one
+      // mass; the largest, unlike the first, does not depend on the order).
+      double m = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) m = std::max(m, double(p.mass[i]));
+      const double s = std::cbrt(m / params_.rest_density);
+      alpha_cap_ = kAlphaCapFactor * dfsph_lattice_factor(*kernel_, m, s);
+    }
+    alpha_.resize(p.size());
+    std::uint64_t pairs = 0;
+    {
+      PhaseScope phase(ctx, "forces.density");
+      pairs = dfsph_density_and_factor(grid_, p, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_));
+    }
+    mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
+    count_evaluation();
   }
 
   // The thesis's path: spatial hash, lists with density inside the search.
@@ -335,6 +426,10 @@ class SphFluid final : public Solver<Real> {
   spatial::NeighbourList<Real> lists_;
   spatial::SortedCellGrid<Real> grid_;
   GridScratch<Real> scratch_;
+  std::optional<DfsphKernel<Real>> kernel_;  // DFSPH: built at the first evaluation
+  AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
+  double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
+  static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
 
   double mean_neighbours_ = 0;
