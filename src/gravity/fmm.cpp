@@ -388,8 +388,14 @@ template <class Real>
 void Fmm<Real>::compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size) {
   const auto t0 = std::chrono::steady_clock::now();
   tree_.build(p, tree_settings(), block_size);
+  evaluate_order(out, block_size, seconds_since(t0));
+}
+
+// The expansion order is a template parameter (the M2L tables unroll at compile time).
+template <class Real>
+void Fmm<Real>::evaluate_order(GravityField<Real>& out, std::size_t block_size, double tree_seconds) {
   stats_ = FmmStats{};
-  stats_.tree_seconds = seconds_since(t0);
+  stats_.tree_seconds = tree_seconds;
   switch (settings_.order) {
     case 2: evaluate<2>(out, block_size); break;
     case 3: evaluate<3>(out, block_size); break;
@@ -404,14 +410,7 @@ void Fmm<Real>::compute_sorted(const ParticleSet<Real>& p, std::span<const std::
                                std::size_t block_size) {
   const auto t0 = std::chrono::steady_clock::now();
   tree_.build_sorted(p, sorted_keys, corner, side, tree_settings(), block_size);
-  stats_ = FmmStats{};
-  stats_.tree_seconds = seconds_since(t0);
-  switch (settings_.order) {
-    case 2: evaluate<2>(out, block_size); break;
-    case 3: evaluate<3>(out, block_size); break;
-    case 4: evaluate<4>(out, block_size); break;
-    default: evaluate<5>(out, block_size); break;
-  }
+  evaluate_order(out, block_size, seconds_since(t0));
 }
 
 template <class Real>

@@ -135,6 +135,7 @@ class Fmm {
     std::vector<Pair> m2l, p2p;
     std::vector<Pair> stack;
   };
+  void evaluate_order(GravityField<Real>& out, std::size_t block_size, double tree_seconds);
   template <int P>
   void evaluate(GravityField<Real>& out, std::size_t block_size);
   template <int P>
