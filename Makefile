@@ -22,13 +22,21 @@ DEMO_OUT ?= out/demo
 DEB_BUILD_PACKAGES := cmake ninja-build g++ make git pkg-config \
                       libtomlplusplus-dev libcli11-dev libfmt-dev \
                       libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core libhdf5-dev \
-                      libboost-dev libboost-system-dev
+                      libboost-dev libboost-system-dev ccache
 # python3-venv, python3-dev and python3-numpy: the Python module's venv (make python).
 DEB_TEST_PACKAGES  := libgtest-dev libbenchmark-dev python3-matplotlib python3-venv python3-dev python3-numpy \
                       python3-h5py
 DEB_PACKAGES       := $(DEB_BUILD_PACKAGES) $(DEB_TEST_PACKAGES)
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
+
+# ccache (installed by deps) under every compiler CMake configures, with paths
+# taken relative to this folder: build/ and build-demo/ then share their objects
+# (same flags, same depth), so `make demo` after `make test` compiles nothing again.
+ifneq ($(shell command -v ccache),)
+export CMAKE_CXX_COMPILER_LAUNCHER ?= ccache
+export CCACHE_BASEDIR ?= $(CURDIR)
+endif
 
 .PHONY: all deps deps-build configure build test unit-test python python-test demo bench asan-test tsan-test fuzz debug clean
 
@@ -70,7 +78,7 @@ python: deps
 	@[ -x $(PY_VENV)/bin/python ] || /usr/bin/python3 -m venv --system-site-packages $(PY_VENV)
 	$(PY_VENV)/bin/pip install -q -r python/requirements-dev.txt
 	CMAKE_BUILD_PARALLEL_LEVEL=$(JOBS) $(PY_VENV)/bin/pip install -q --no-build-isolation \
-	  --config-settings=build-dir=build-python/build --config-settings=cmake.define.SWIRL_NATIVE=ON $(if $(shell command -v ccache),--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=ccache) .
+	  --config-settings=build-dir=build-python/build --config-settings=cmake.define.SWIRL_NATIVE=ON $(if $(CMAKE_CXX_COMPILER_LAUNCHER),--config-settings=cmake.define.CMAKE_CXX_COMPILER_LAUNCHER=$(CMAKE_CXX_COMPILER_LAUNCHER)) .
 
 # pytest on the installed module; the CLI of `make build` is the reference of
 # the byte-identical frames test.

@@ -59,12 +59,14 @@ for f in "$LLVM/bin/clang++" "$LLVM/lib/libomp.so" "$LLVM/lib/libarcher.so" "$LL
 done
 
 echo "== tsan: configure $BUILD (clang ${LLVM_VERSION}, -fsanitize=thread, libomp)"
+# -O1 -g1 (line tables are all a report needs): clang builds src/gravity/fmm.cpp
+# with TSan 10x faster than at -O2 -g (14 s against 156 s), typical files 1.5-2x.
 # SWIRL_WERROR=OFF: the warning set is tuned for g++; clang's extra warnings
 # are shown below but do not stop this job.
 mkdir -p "$BUILD"
 cmake -S . -B "$BUILD" -G Ninja \
   -DCMAKE_CXX_COMPILER="$LLVM/bin/clang++" \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
   -DSWIRL_WERROR=OFF -DSWIRL_NATIVE=OFF -DSWIRL_SANITIZE=OFF \
   -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
   -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=thread" >"$BUILD/tsan-configure.log" 2>&1 ||
