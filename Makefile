@@ -4,7 +4,7 @@
 #   make test   install what is missing, build, run every test with CTest, then the
 #               parallel tests under ThreadSanitizer and a fuzz smoke run (60 s per target)
 #
-# Other targets: python (the Python module into build-python/venv; docs/python.md),
+# Other targets: mpi (swirl with OpenMPI: mpirun -n 4 build/swirl ...), python (the Python module into build-python/venv; docs/python.md),
 # python-test (pytest; part of test), build, bench (the seeds' experiments -> docs/performance.md), unit-test (CTest only), asan-test (tests under
 # AddressSanitizer+UBSan, long tests skipped), tsan-test (the parallel tests
 # under ThreadSanitizer), fuzz (libFuzzer smoke run; FUZZ_SECONDS=600 for
@@ -23,9 +23,11 @@ DEB_BUILD_PACKAGES := cmake ninja-build g++ make git pkg-config \
                       libtomlplusplus-dev libcli11-dev libfmt-dev \
                       libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core libhdf5-dev \
                       libboost-dev libboost-system-dev ccache
+# OpenMPI for distributed runs (make mpi; the tests run under mpirun). Not the demo's.
+DEB_MPI_PACKAGES   := libopenmpi-dev openmpi-bin
 # python3-venv, python3-dev and python3-numpy: the Python module's venv (make python).
 DEB_TEST_PACKAGES  := libgtest-dev libbenchmark-dev python3-matplotlib python3-venv python3-dev python3-numpy \
-                      python3-h5py
+                      python3-h5py $(DEB_MPI_PACKAGES)
 DEB_PACKAGES       := $(DEB_BUILD_PACKAGES) $(DEB_TEST_PACKAGES)
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
@@ -38,14 +40,15 @@ export CMAKE_CXX_COMPILER_LAUNCHER ?= ccache
 export CCACHE_BASEDIR ?= $(CURDIR)
 endif
 
-.PHONY: all deps deps-build configure build test unit-test python python-test demo bench asan-test tsan-test fuzz debug clean
+.PHONY: all deps deps-build deps-mpi mpi configure build test unit-test python python-test demo bench asan-test tsan-test fuzz debug clean
 
 all: build
 
 # deps-build installs what building the tool needs; deps adds the test-only packages.
 deps: PACKAGES = $(DEB_PACKAGES)
 deps-build: PACKAGES = $(DEB_BUILD_PACKAGES)
-deps deps-build:
+deps-mpi: PACKAGES = $(DEB_BUILD_PACKAGES) $(DEB_MPI_PACKAGES)
+deps deps-build deps-mpi:
 	@missing=""; \
 	for p in $(PACKAGES); do \
 	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
@@ -63,6 +66,13 @@ build: configure
 	cmake --build --preset $(PRESET) -j $(JOBS)
 
 test: unit-test python-test tsan-test fuzz
+
+# swirl with MPI (OpenMPI from Debian) in build/: mpirun -n 4 build/swirl run SCENE
+# (docs/design/mpi.md says what runs distributed so far).
+mpi: deps-mpi
+	cmake --preset $(PRESET) -DSWIRL_MPI=ON
+	cmake --build --preset $(PRESET) -j $(JOBS) --target swirl_cli
+	@echo "swirl with MPI: mpirun -n 2 build$(if $(filter-out release,$(PRESET)),-$(PRESET))/swirl info"
 
 unit-test: build
 	ctest --preset $(PRESET)

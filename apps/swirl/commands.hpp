@@ -14,6 +14,9 @@ namespace swirl::cli {
 struct Command {
   CLI::App* app;                // parsed() tells whether this command was given
   std::function<int()> action;  // returns the process's exit status
+  // Whether the command runs on several MPI ranks (under mpirun); the others
+  // refuse to start there (run_cli.cpp).
+  bool distributed = false;
 };
 using Commands = std::vector<Command>;
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "commands.hpp"
+#include "swirl/dist/communicator.hpp"
 #include "swirl/config.hpp"
 #include "swirl/core/simd_dispatch.hpp"
 #include "swirl/sim/simd_lanes.hpp"
@@ -28,6 +29,8 @@ int vector_width_bits() {
 }
 
 int print_info() {
+  const dist::Communicator& comm = dist::Communicator::world();
+  if (!comm.is_root()) return 0;  // one rank speaks for the run
   fmt::print("swirl {}\n", SWIRL_VERSION);
   fmt::print("  git revision     {}\n", SWIRL_GIT_REVISION);
   fmt::print("  build type       {}\n", SWIRL_BUILD_TYPE);
@@ -42,13 +45,18 @@ int print_info() {
     copies += simd::cpu_supports(isa) ? fmt::format(" ({} floats)", sim::simd_float_lanes(isa)) : " (not on this CPU)";
   }
   fmt::print("  SIMD kernels     {} active (SWIRL_SIMD to choose); compiled: {}\n", simd::isa_name(simd::active()), copies);
+  if (dist::MpiSession::built_with_mpi())
+    fmt::print("  MPI              {} ({} rank{})\n", dist::MpiSession::library_version(), comm.size(),
+               comm.size() == 1 ? "" : "s");
+  else
+    fmt::print("  MPI              not built (SWIRL_MPI=OFF)\n");
   return 0;
 }
 
 }  // namespace
 
 void add_info_command(CLI::App& app, Commands& commands) {
-  commands.push_back({app.add_subcommand("info", "Print version, build and machine facts"), [] { return print_info(); }});
+  commands.push_back({app.add_subcommand("info", "Print version, build and machine facts"), [] { return print_info(); }, true});
 }
 
 }  // namespace swirl::cli

@@ -8,7 +8,7 @@ independent. A module missing from the table fails the check, so a new module
 must be placed in it.
 
 The ranks are the layering that holds today (lowest first). docs name the
-coarse layers core; parallel; spatial, io; force, integrate, boundary, sph,
+coarse layers core; parallel; spatial, io, dist; force, integrate, boundary, sph,
 gravity; scene; sim; render, view; CLI. Within the solver layer the includes are
 finer: the steppers (integrate) apply the box (boundary) and return the
 step's scan (force/step_scan.hpp); sph and gravity implement the Solver seam
@@ -25,7 +25,7 @@ import sys
 RANK = {
     "core": 0,
     "parallel": 1,
-    "spatial": 2, "io": 2,
+    "spatial": 2, "io": 2, "dist": 2,
     "boundary": 3,
     "force": 4,
     "integrate": 5,

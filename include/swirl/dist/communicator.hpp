@@ -1,0 +1,81 @@
+// Communicator: the ranks of one run (MPI processes), and the few collective
+// operations the distributed pieces need, all of them exact (integer sums,
+// min, max, byte exchanges) so that nothing they return depends on the number
+// of ranks or on the order in which messages arrive.
+//
+// One binary: built with MPI (CMake option SWIRL_MPI) and started by mpirun,
+// world() is MPI_COMM_WORLD; otherwise (no MPI in the build, or a plain start
+// without a launcher) it is a single rank and every operation is the identity.
+// MPI's header stays in src/dist/communicator.cpp: nothing else sees it.
+//
+// MpiSession owns MPI's lifetime (one per process, in main): it initialises MPI
+// only when a launcher started the process (mpirun sets OMPI_COMM_WORLD_SIZE,
+// PMI_SIZE or PMIX_RANK), with MPI_THREAD_FUNNELED (OpenMP threads never call
+// MPI), and finalises it at exit. abort() ends every rank at once with the
+// given exit status (MPI_Abort): an error on one rank must never leave the
+// others waiting in a collective.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace swirl::dist {
+
+using Bytes = std::vector<std::byte>;
+
+class Communicator {
+ public:
+  // The ranks of this process's run: MPI_COMM_WORLD under an MpiSession, one rank otherwise.
+  static const Communicator& world();
+
+  int rank() const { return rank_; }
+  int size() const { return size_; }
+  bool distributed() const { return size_ > 1; }
+  bool is_root() const { return rank_ == 0; }
+
+  // Element-wise exact reductions, the result on every rank.
+  void sum(std::span<std::uint64_t> values) const;
+  void min(std::span<double> values) const;
+  void max(std::span<double> values) const;
+  std::uint64_t sum(std::uint64_t value) const;
+  // The sum of value over the ranks below this one (0 on rank 0).
+  std::uint64_t exclusive_prefix_sum(std::uint64_t value) const;
+  // value from every rank, in rank order, on every rank.
+  std::vector<std::uint64_t> all_gather(std::uint64_t value) const;
+
+  // Personalised exchange: send[d] goes to rank d; returns what each rank sent
+  // here, indexed by source rank (send.size() must be size()).
+  std::vector<Bytes> all_to_all(const std::vector<Bytes>& send) const;
+
+  // Every rank's bytes on rank 0, in rank order (other ranks get an empty list).
+  std::vector<Bytes> gather_to_root(const Bytes& mine) const;
+
+  void barrier() const;
+
+  // Ends every rank of the run with this exit status (never returns).
+  [[noreturn]] void abort(int exit_status) const;
+
+ private:
+  Communicator() = default;
+  friend class MpiSession;
+  int rank_ = 0;
+  int size_ = 1;
+  bool mpi_ = false;
+};
+
+class MpiSession {
+ public:
+  // Initialises MPI when the build has it and a launcher started this process.
+  MpiSession(int& argc, char**& argv);
+  ~MpiSession();
+  MpiSession(const MpiSession&) = delete;
+  MpiSession& operator=(const MpiSession&) = delete;
+
+  // Whether this build was compiled with MPI (SWIRL_MPI), and which library.
+  static bool built_with_mpi();
+  static const char* library_version();
+};
+
+}  // namespace swirl::dist

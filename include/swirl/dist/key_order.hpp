@@ -1,0 +1,134 @@
+// The global particle order across ranks (docs/design/mpi.md, "The invariant").
+//
+// Invariant: the ranks' particles, concatenated in rank order, are the one-rank
+// memory order. Rank r holds the contiguous range [first_r, first_r + n_r) of
+// the global order, so a particle's global index is first_r + its local index
+// and need not be stored.
+//
+// distribute_in_key_order() restores the invariant after the keys changed (a
+// new step's positions) and, at the same time, moves every particle to the rank
+// whose key range holds its key (migration; a rebalance is the same call with
+// new cuts). Afterwards each rank's particles are sorted by (key, previous
+// global index): since the previous global index is the previous memory order
+// of a one-rank run, the concatenation is exactly the stable sort by key of
+// parallel::RadixSort on one rank, whatever the rank count. Every field moves
+// (real, integer, ids: all of ParticleSet), bit for bit.
+//
+// Cut keys: ranks own half-open key ranges [cut[r-1], cut[r]) with cut[-1] = 0
+// and cut[size-1] = +inf; cut_keys holds the size-1 inner cuts, nondecreasing.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <numeric>
+#include <span>
+#include <stdexcept>
+#include <vector>
+
+#include "swirl/core/particle_set.hpp"
+#include "swirl/dist/communicator.hpp"
+
+namespace swirl::dist {
+
+// The rank whose key range holds key.
+inline int owner_of(std::uint64_t key, std::span<const std::uint64_t> cut_keys) {
+  return static_cast<int>(std::upper_bound(cut_keys.begin(), cut_keys.end(), key) - cut_keys.begin());
+}
+
+// What one call moved: particles sent to other ranks (this rank's count).
+struct Distribution {
+  std::uint64_t first_global_index = 0;  // of this rank's first particle, in the new order
+  std::uint64_t global_count = 0;
+  std::size_t sent_away = 0;
+};
+
+// particles[i] has key keys[i] and global index first_global_index + i (the
+// previous order). On return particles and keys hold this rank's range of the
+// new global order. Collective: every rank calls it with the same cut_keys.
+template <class Real>
+Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>& particles,
+                                     std::vector<std::uint64_t>& keys, std::uint64_t first_global_index,
+                                     std::span<const std::uint64_t> cut_keys) {
+  using Int = typename ParticleSet<Real>::int_type;
+  const std::size_t n = particles.size();
+  if (keys.size() != n) throw std::invalid_argument("distribute_in_key_order: one key per particle is needed");
+  if (cut_keys.size() + 1 != static_cast<std::size_t>(comm.size()))
+    throw std::invalid_argument("distribute_in_key_order: size()-1 cut keys are needed");
+  if (!std::is_sorted(cut_keys.begin(), cut_keys.end()))
+    throw std::invalid_argument("distribute_in_key_order: cut keys must be nondecreasing");
+
+  std::size_t real_arrays = 0, int_arrays = 0;
+  particles.for_each_array([&](const AlignedVector<Real>&) { ++real_arrays; });
+  particles.for_each_int_array([&](const AlignedVector<Int>&) { ++int_arrays; });
+  // One record per particle: key, previous global index, id, the real fields, the integer fields.
+  const std::size_t record = 3 * sizeof(std::uint64_t) + real_arrays * sizeof(Real) + int_arrays * sizeof(Int);
+
+  const auto ranks = static_cast<std::size_t>(comm.size());
+  std::vector<Bytes> send(ranks);
+  std::vector<int> destination(n);
+  std::vector<std::size_t> per_rank(ranks, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    destination[i] = owner_of(keys[i], cut_keys);
+    ++per_rank[static_cast<std::size_t>(destination[i])];
+  }
+  std::vector<std::size_t> filled(ranks, 0);
+  for (std::size_t d = 0; d < ranks; ++d) send[d].resize(per_rank[d] * record);
+  auto put = [](std::byte*& at, const auto& value) {
+    std::memcpy(at, &value, sizeof(value));
+    at += sizeof(value);
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto d = static_cast<std::size_t>(destination[i]);
+    std::byte* at = send[d].data() + filled[d]++ * record;
+    put(at, keys[i]);
+    put(at, std::uint64_t{first_global_index + i});
+    put(at, particles.id[i]);
+    particles.for_each_array([&](const AlignedVector<Real>& a) { put(at, a[i]); });
+    particles.for_each_int_array([&](const AlignedVector<Int>& a) { put(at, a[i]); });
+  }
+  Distribution result;
+  result.sent_away = n - per_rank[static_cast<std::size_t>(comm.rank())];
+
+  const std::vector<Bytes> received = comm.all_to_all(send);
+  send.clear();
+  std::size_t count = 0;
+  for (const Bytes& b : received) {
+    if (b.size() % record != 0) throw std::runtime_error("distribute_in_key_order: a rank sent a partial record");
+    count += b.size() / record;
+  }
+  // Unpack in arrival order (source rank order), then sort by (key, previous global index).
+  particles.resize(count);
+  keys.resize(count);
+  std::vector<std::uint64_t> previous_index(count);
+  auto get = [](const std::byte*& at, auto& value) {
+    std::memcpy(&value, at, sizeof(value));
+    at += sizeof(value);
+  };
+  std::size_t j = 0;
+  for (const Bytes& b : received) {
+    for (const std::byte* at = b.data(); at != b.data() + b.size(); ++j) {
+      get(at, keys[j]);
+      get(at, previous_index[j]);
+      get(at, particles.id[j]);
+      particles.for_each_array([&](AlignedVector<Real>& a) { get(at, a[j]); });
+      particles.for_each_int_array([&](AlignedVector<Int>& a) { get(at, a[j]); });
+    }
+  }
+  std::vector<std::size_t> order(count);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return keys[a] != keys[b] ? keys[a] < keys[b] : previous_index[a] < previous_index[b];
+  });
+  particles.reorder(order);
+  std::vector<std::uint64_t> sorted_keys(count);
+  for (std::size_t i = 0; i < count; ++i) sorted_keys[i] = keys[order[i]];
+  keys.swap(sorted_keys);
+
+  result.first_global_index = comm.exclusive_prefix_sum(count);
+  result.global_count = comm.sum(static_cast<std::uint64_t>(count));
+  return result;
+}
+
+}  // namespace swirl::dist

@@ -1,0 +1,63 @@
+// The communicator's collectives on 1-4 ranks (run by CTest under mpirun).
+#include "swirl/dist/communicator.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+namespace swirl::dist {
+namespace {
+
+TEST(Communicator, RanksAndExactReductions) {
+  const Communicator& comm = Communicator::world();
+  ASSERT_GE(comm.size(), 1);
+  ASSERT_LT(comm.rank(), comm.size());
+  const auto r = static_cast<std::uint64_t>(comm.rank());
+  const auto n = static_cast<std::uint64_t>(comm.size());
+  EXPECT_EQ(comm.sum(r + 1), n * (n + 1) / 2);
+  EXPECT_EQ(comm.exclusive_prefix_sum(r + 1), r * (r + 1) / 2);
+  std::vector<double> low{static_cast<double>(comm.rank()), -static_cast<double>(comm.rank())};
+  std::vector<double> high = low;
+  comm.min(low);
+  comm.max(high);
+  EXPECT_EQ(low[0], 0.0);
+  EXPECT_EQ(low[1], -static_cast<double>(n - 1));
+  EXPECT_EQ(high[0], static_cast<double>(n - 1));
+  EXPECT_EQ(high[1], 0.0);
+  const std::vector<std::uint64_t> all = comm.all_gather(10 * r);
+  ASSERT_EQ(all.size(), n);
+  for (std::uint64_t s = 0; s < n; ++s) EXPECT_EQ(all[s], 10 * s);
+}
+
+TEST(Communicator, AllToAllDeliversEachBufferToItsRank) {
+  const Communicator& comm = Communicator::world();
+  const auto ranks = static_cast<std::size_t>(comm.size());
+  // Rank s sends s+d+1 bytes of value 16·s + d to rank d (some empty: none here).
+  std::vector<Bytes> send(ranks);
+  for (std::size_t d = 0; d < ranks; ++d)
+    send[d].assign(static_cast<std::size_t>(comm.rank()) + d + 1, std::byte(16 * comm.rank() + static_cast<int>(d)));
+  const std::vector<Bytes> got = comm.all_to_all(send);
+  ASSERT_EQ(got.size(), ranks);
+  for (std::size_t s = 0; s < ranks; ++s) {
+    ASSERT_EQ(got[s].size(), s + static_cast<std::size_t>(comm.rank()) + 1);
+    for (std::byte b : got[s]) EXPECT_EQ(b, std::byte(16 * static_cast<int>(s) + comm.rank()));
+  }
+}
+
+TEST(Communicator, GatherToRootKeepsRankOrder) {
+  const Communicator& comm = Communicator::world();
+  Bytes mine(static_cast<std::size_t>(comm.rank()), std::byte(comm.rank()));
+  const std::vector<Bytes> all = comm.gather_to_root(mine);
+  if (!comm.is_root()) {
+    EXPECT_TRUE(all.empty());
+    return;
+  }
+  ASSERT_EQ(all.size(), static_cast<std::size_t>(comm.size()));
+  for (std::size_t s = 0; s < all.size(); ++s) {
+    EXPECT_EQ(all[s], Bytes(s, std::byte(s)));
+  }
+}
+
+}  // namespace
+}  // namespace swirl::dist
