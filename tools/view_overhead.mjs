@@ -11,7 +11,8 @@
 // modes in turn, so a busy machine's drift falls on every mode alike:
 //   none      no viewer (the frames are still copied and encoded: swirl does
 //             that whether or not anyone watches);
-//   socket    a bare WebSocket client (Node's, --experimental-websocket) that
+//   socket    a bare WebSocket client (Node's, --experimental-websocket: Node ≥ 20.10,
+//             so not Debian 12's Node 18; --modes none,chromium there) that
 //             receives the frames and counts their bytes: the server's side alone;
 //   chromium  the page in headless Chromium on the same machine (WebGL2 on
 //             SwiftShader: software drawing, which competes for the cores).
