@@ -5,6 +5,7 @@
 #               parallel tests under ThreadSanitizer and a fuzz smoke run (60 s per target)
 #
 # Other targets: mpi (swirl with OpenMPI: mpirun -n 4 build/swirl ...), python (the Python module into build-python/venv; docs/python.md),
+# browser-deps (the browser test's npm packages, tests/browser/),
 # python-test (pytest; part of test), build, bench (the seeds' experiments -> docs/performance.md), unit-test (CTest only), asan-test (tests under
 # AddressSanitizer+UBSan, long tests skipped), tsan-test (the parallel tests
 # under ThreadSanitizer), fuzz (libFuzzer smoke run; FUZZ_SECONDS=600 for
@@ -26,8 +27,10 @@ DEB_BUILD_PACKAGES := cmake ninja-build g++ make git pkg-config \
 # OpenMPI for distributed runs (make mpi; the tests run under mpirun). Not the demo's.
 DEB_MPI_PACKAGES   := libopenmpi-dev openmpi-bin
 # python3-venv, python3-dev and python3-numpy: the Python module's venv (make python).
+# chromium and nodejs: the browser test of swirl view's page (tests/browser/; its npm
+# packages come from its lock file, browser-deps).
 DEB_TEST_PACKAGES  := libgtest-dev libbenchmark-dev python3-matplotlib python3-venv python3-dev python3-numpy \
-                      python3-h5py $(DEB_MPI_PACKAGES)
+                      python3-h5py chromium nodejs $(DEB_MPI_PACKAGES)
 DEB_PACKAGES       := $(DEB_BUILD_PACKAGES) $(DEB_TEST_PACKAGES)
 
 SUDO := $(shell [ "$$(id -u)" -eq 0 ] || echo sudo)
@@ -40,7 +43,7 @@ export CMAKE_CXX_COMPILER_LAUNCHER ?= ccache
 export CCACHE_BASEDIR ?= $(CURDIR)
 endif
 
-.PHONY: all deps deps-build deps-mpi mpi configure build test unit-test python python-test demo bench asan-test tsan-test fuzz debug clean
+.PHONY: all deps deps-build deps-mpi mpi browser-deps configure build test unit-test python python-test demo bench asan-test tsan-test fuzz debug clean
 
 all: build
 
@@ -74,7 +77,16 @@ mpi: deps-mpi
 	cmake --build --preset $(PRESET) -j $(JOBS) --target swirl_cli
 	@echo "swirl with MPI: mpirun -n 2 build$(if $(filter-out release,$(PRESET)),-$(PRESET))/swirl info"
 
-unit-test: build
+# The browser test's harness (tests/browser/: puppeteer-core, which downloads no
+# browser: the test drives Debian's chromium) from its lock file, again only when
+# the lock file changed. npm: NodeSource's nodejs bundles it, Debian's has it apart.
+browser-deps: deps
+	@command -v npm >/dev/null || { $(SUDO) apt-get update -q && \
+	  DEBIAN_FRONTEND=noninteractive $(SUDO) apt-get install -y -q --no-install-recommends npm; }
+	@[ tests/browser/node_modules/.package-lock.json -nt tests/browser/package-lock.json ] || \
+	  (cd tests/browser && npm ci --no-audit --no-fund --ignore-scripts)
+
+unit-test: build browser-deps
 	ctest --preset $(PRESET)
 	bash tools/check_simd_objects.sh build$(if $(filter-out release,$(PRESET)),-$(PRESET))
 

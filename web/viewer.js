@@ -13,8 +13,16 @@ const state = {
   hello: null, frame: null, count: 0, lo: [0, 0, 0], hi: [1, 1, 1],
   yaw: 0.6, pitch: 0.35, distance: 3, target: [0, 0, 0], framed: false,
   paused: false, status: null, history: [], frames: 0, lastDraw: performance.now(), fps: 0,
+  positions: null, frameMs: [],
 };
-window.swirlView = state;  // for tests and the console
+// The test hook (tests/browser/view_test.mjs, tools/view_overhead.mjs) and the
+// console: window.swirlView is this state: hello (the server's hello), step and
+// time (newest frame's), lo/hi (its quantisation box), count and positions
+// (its u16 x,y,z triples: lo + q/65535·(hi − lo)), received (frames decoded),
+// status (newest status message: step, paused, steps_per_second...), paused,
+// frames (drawn) and frameMs (the last 240 intervals between drawn frames, ms).
+// The camera (yaw, pitch, distance, target) may be set; worldAt(x, y) is global.
+window.swirlView = state;
 
 // ---- Maths -------------------------------------------------------------------
 function perspective(fovy, aspect, near, far) {
@@ -104,6 +112,8 @@ function draw() {
   }
   const now = performance.now();
   state.fps = 0.9 * state.fps + 0.1 * (1000 / Math.max(1, now - state.lastDraw));
+  state.frameMs.push(now - state.lastDraw);
+  if (state.frameMs.length > 240) state.frameMs.shift();
   state.lastDraw = now;
   state.frames++;
   requestAnimationFrame(draw);
@@ -124,7 +134,7 @@ function onFrame(buffer) {
   state.time = dv.getFloat64(16, true);
   for (let a = 0; a < 3; a++) { state.lo[a] = dv.getFloat32(28 + 4 * a, true); state.hi[a] = dv.getFloat32(40 + 4 * a, true); }
   state.colourRange = [dv.getFloat32(52, true), dv.getFloat32(56, true)];
-  gl.bindBuffer(gl.ARRAY_BUFFER, qbuf); gl.bufferData(gl.ARRAY_BUFFER, new Uint16Array(buffer, 60, 3 * n), gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ARRAY_BUFFER, qbuf); gl.bufferData(gl.ARRAY_BUFFER, state.positions = new Uint16Array(buffer, 60, 3 * n), gl.DYNAMIC_DRAW);
   gl.bindBuffer(gl.ARRAY_BUFFER, cbuf); gl.bufferData(gl.ARRAY_BUFFER, new Uint8Array(buffer, 60 + 6 * n, n), gl.DYNAMIC_DRAW);
   if (!state.framed) frameCamera();
   state.received = (state.received || 0) + 1;

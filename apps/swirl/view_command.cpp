@@ -73,9 +73,12 @@ int view(const ViewArgs& args) {
   if (timer) timer->join();
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
-  fmt::print("swirl view: {} steps in {:.1f} s ({} resets); {} frames sent ({:.1f} MB), {} controls, {} dropped, {} viewers\n",
-             r.steps, r.wall_seconds, r.resets, r.server.frames_sent, double(r.server.bytes_sent) / 1e6, r.server.controls,
-             r.server.dropped, r.server.sessions);
+  // steps/s over the session after the set-up (tools/view_overhead.mjs reads this line).
+  const double stepping = r.wall_seconds - r.setup_seconds;
+  fmt::print("swirl view: {} steps in {:.1f} s ({} resets; {:.2f} steps/s after {:.1f} s of set-up); {} frames sent ({:.1f} MB), "
+             "{} controls, {} dropped, {} viewers\n",
+             r.steps, r.wall_seconds, r.resets, stepping > 0 ? double(r.steps) / stepping : 0.0, r.setup_seconds,
+             r.server.frames_sent, double(r.server.bytes_sent) / 1e6, r.server.controls, r.server.dropped, r.server.sessions);
   return 0;
 }
 

@@ -76,6 +76,7 @@ class LiveSession {
   ViewResult run() {
     const auto t0 = Clock::now();
     build();
+    const auto t_built = Clock::now();
     server_.start();
     if (options_.on_listening) options_.on_listening(server_);
     std::thread encoder([this] { encode_loop(); });
@@ -111,6 +112,7 @@ class LiveSession {
     r.steps = steps_;
     r.resets = resets_;
     r.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    r.setup_seconds = std::chrono::duration<double>(t_built - t0).count();
     r.server = server_.stats();
     return r;
   }

@@ -42,6 +42,7 @@ struct ViewResult {
   std::uint64_t steps = 0;    // steps taken in the session (over resets)
   std::uint64_t resets = 0;
   double wall_seconds = 0;
+  double setup_seconds = 0;   // of which building the simulation before the first step
   ServerStats server;
 };
 
