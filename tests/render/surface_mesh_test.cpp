@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <numbers>
@@ -58,6 +59,8 @@ TEST(SurfaceMesh, SphereOfFluidIsClosedAndHoldsTheFluidsVolume) {
   expect_closed(mesh);
   const double fluid = static_cast<double>(positions.size()) * volume[0];
   const double enclosed = enclosed_volume(mesh);
+  std::printf("sphere of %zu particles: mesh volume / fluid volume = %.5f, %zu triangles\n", positions.size(),
+              enclosed / fluid, mesh.triangle_count());
   EXPECT_NEAR(enclosed / fluid, 1.0, 0.02) << positions.size() << " particles, fluid " << fluid << " m³, mesh "
                                            << enclosed << " m³";
   // Normals point outwards: away from the centre.
@@ -96,6 +99,7 @@ TEST(SurfaceMesh, FlatSurfaceLiesHalfASpacingAboveTheTopLayer) {
   EXPECT_GT(bottom, 100);
   // The slab's volume, less what its rounded edges and corners lose.
   const double fluid = static_cast<double>(positions.size()) * volume[0];
+  std::printf("slab: mesh volume / fluid volume = %.5f\n", enclosed_volume(mesh) / fluid);
   EXPECT_NEAR(enclosed_volume(mesh) / fluid, 1.0, 0.03);
 }
 
