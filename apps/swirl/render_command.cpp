@@ -2,7 +2,7 @@
 //
 //   swirl render RUN_DIR [--frame K | --all] [--view front|top|iso] [--projection ortho|perspective]
 //                [--color speed|density|pressure|mass] [--size WxH] [--range LO,HI] [--out DIR]
-//                [--movie] [--fps N] [--threads N]
+//                [--surface] [--movie] [--fps N] [--threads N]
 //
 // Without --frame or --all the last frame is drawn. Pictures go to
 // RUN_DIR/render/particles_NNNNNN.png (or --out DIR), the movie to
@@ -38,6 +38,7 @@ struct RenderArgs {
   std::string size = "1280x720";
   std::string range;
   std::string out;
+  bool surface = false;
   bool movie = false;
   int fps = 25;
   int threads = 0;
@@ -78,6 +79,7 @@ int render(const RenderArgs& args) {
   if (!args.color.empty()) options.color = render::parse_quantity(args.color);
   std::tie(options.width, options.height) = parse_size(args.size);
   if (!args.range.empty()) options.range = parse_range(args.range);
+  options.surface = args.surface;
   if (args.threads > 0) parallel::set_thread_count(args.threads);
   // Refuse before drawing anything when the movie cannot be made.
   if (args.movie && !render::find_program("ffmpeg"))
@@ -119,7 +121,8 @@ int render(const RenderArgs& args) {
     written.push_back(png);
   }
   const auto [lo, hi] = renderer.range();
-  const std::string colours = renderer.log_density_view()
+  const std::string colours = args.surface ? std::string("water surface")
+                              : renderer.log_density_view()
                                   ? fmt::format("log surface density {:.3g} to {:.3g}", lo, hi)
                                   : fmt::format("{} {:.4g} to {:.4g}", render::quantity_name(renderer.quantity()), lo, hi);
   if (written.size() == 1)
@@ -157,6 +160,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
   cmd->add_option("--size", args->size, "Picture size WIDTHxHEIGHT (default 1280x720)");
   cmd->add_option("--range", args->range, "Colour range LO,HI (log10 of the surface density for gravity runs)");
   cmd->add_option("--out,-o", args->out, "Where the pictures go (default: RUN_DIR/render)");
+  cmd->add_flag("--surface", args->surface,
+                "Draw the fluid as a water surface (a mesh of its colour field, docs/surface.md) instead of particles");
   cmd->add_flag("--movie", args->movie, "Also make DIR/movie.mp4 of every frame with ffmpeg (implies --all)")->excludes(frame);
   cmd->add_option("--fps", args->fps, "Movie frames per second (default 25)")->check(whole_number(1, 1000));
   cmd->add_option("--threads,-t", args->threads, "Threads (default: all cores); pictures are identical for any count")

@@ -131,6 +131,18 @@ int run(const RunArgs& args) {
     render::Font{};
     options.on_frame = render::render_every(options.out_dir, args.render_every);
   }
+  if (scene.surface != scene::SurfaceFormat::None) {
+    // output.surface: the fluid's mesh beside each frame (after any picture of it).
+    auto surfaces = render::surface_frames(options.out_dir, render::fluid_surface_of(scene));
+    if (options.on_frame)
+      options.on_frame = [pictures = std::move(options.on_frame), surfaces = std::move(surfaces)](
+                             const std::filesystem::path& frame, double time, const sim::ClaimFile& claim) {
+        pictures(frame, time, claim);
+        surfaces(frame, time, claim);
+      };
+    else
+      options.on_frame = std::move(surfaces);
+  }
   // Cleared first: run_cli() may run many times in one process (the Python module).
   g_stop.store(false);
   g_signal.store(0);

@@ -21,6 +21,7 @@
 #include <nanobind/stl/vector.h>
 
 #include "bindings.hpp"
+#include "swirl/render/fluid_surface.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/observer.hpp"
 #include "swirl/sim/run.hpp"
@@ -170,6 +171,9 @@ nb::dict run(const scene::Scene& scene, const std::string& out_dir, bool resume,
   else throw nb::value_error(("on_blowup '" + a.on_blowup + "': give \"stop\", \"warn\" or \"off\"").c_str());
   std::atomic<bool> stop{false};
   options.stop = &stop;
+  // output.surface: the fluid's mesh beside each frame, as `swirl run` writes it.
+  if (scene.surface != scene::SurfaceFormat::None)
+    options.on_frame = render::surface_frames(out_dir, render::fluid_surface_of(scene));
   hooks.stop = &stop;
   if (hooks.any()) {
     options.extend_float = python_extension<float>(scene, hooks);

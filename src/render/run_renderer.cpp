@@ -16,6 +16,7 @@
 #include "swirl/render/png.hpp"
 #include "swirl/render/splats.hpp"
 #include "swirl/render/surface_density.hpp"
+#include "swirl/render/water.hpp"
 #include "swirl/scene/load.hpp"
 
 namespace swirl::render {
@@ -165,6 +166,7 @@ RunInfo run_info_of(const scene::Scene& s) {
   if (s.walls && !run.nbody) run.box = s.box;
   run.gravity = s.gravity;
   if (s.sph) run.rest_density = s.sph->rest_density;
+  run.surface = fluid_surface_of(s);
   return run;
 }
 
@@ -190,6 +192,10 @@ RunRenderer::RunRenderer(const Frame& first, RunInfo run, RenderOptions options)
     throw std::invalid_argument("colour range: the upper end must be above the lower end");
   quantity_ = options_.color.value_or(run_.nbody ? Quantity::Density : Quantity::Speed);
   log_density_ = run_.nbody && quantity_ == Quantity::Density;
+  if (options_.surface && run_.nbody && !(run_.rest_density > 0))
+    throw std::invalid_argument("--surface draws a fluid's surface, and this is a gravity run with no [sph] fluid; "
+                                "draw it without --surface");
+  if (options_.surface) log_density_ = false;
   if (first.positions.empty()) throw io::IoError(first.file.string() + ": the frame has no particles");
 
   const int bar_area = std::min(std::max(190, options_.width / 6), options_.width / 3);
@@ -258,6 +264,9 @@ Image RunRenderer::render(const Frame& frame) const {
             : std::vector<double>(frame.positions.size(), 1.0 / static_cast<double>(std::max<std::size_t>(frame.positions.size(), 1)));
     const DensityMap density = surface_density(camera_, W, H, frame.positions, masses, density_kernel(H));
     draw_log_density(image, density, map, range_.first, range_.second);
+  } else if (options_.surface) {
+    if (run_.box) draw_box_edges(image, camera_, *run_.box);
+    draw_water(image, camera_, frame_surface(frame, run_.surface));
   } else {
     if (run_.box) draw_box_edges(image, camera_, *run_.box);
     SplatStyle style;
@@ -274,22 +283,27 @@ Image RunRenderer::render(const Frame& frame) const {
   for (int y = 0; y < H; ++y)
     for (int x = plot_width_; x < W; ++x) image.at(x, y) = panel;
   const int title_px = std::max(10, H / 36), tick_px = std::max(9, H / 45);
+  if (options_.surface) {
+    font_.draw(image, "water surface", plot_width_ + std::max(8, W / 120), H / 5 - title_px * 2, title_px, kText);
+    font_.draw(image, fmt::format("colour field at {:g}", run_.surface.iso), plot_width_ + std::max(8, W / 120),
+               H / 5 - title_px * 2 + title_px + title_px / 3, tick_px, kText);
+  }
   const int bar_x0 = plot_width_ + std::max(12, W / 80), bar_w = std::max(12, W / 70);
   const int bar_y0 = H / 5, bar_y1 = H - H / 6;
-  for (int y = bar_y0; y <= bar_y1; ++y) {
+  for (int y = bar_y0; y <= bar_y1 && !options_.surface; ++y) {
     const Color c = colormap(map, static_cast<double>(bar_y1 - y) / (bar_y1 - bar_y0));
     for (int x = bar_x0; x < bar_x0 + bar_w; ++x) image.at(x, y) = c;
   }
   const int ticks = 5;
-  for (int k = 0; k < ticks; ++k) {
+  for (int k = 0; k < ticks && !options_.surface; ++k) {
     const double f = static_cast<double>(k) / (ticks - 1);
     const int y = bar_y1 - static_cast<int>(std::lround(f * (bar_y1 - bar_y0)));
     for (int x = bar_x0 + bar_w; x < bar_x0 + bar_w + 5; ++x) image.blend(x, y, kText, 1.0f);
     font_.draw(image, tick_label(range_.first + f * (range_.second - range_.first), log_density_), bar_x0 + bar_w + 8,
                y + tick_px / 2 - 1, tick_px, kText);
   }
-  const std::string title = quantity_title(quantity_, run_.nbody, log_density_);
-  font_.draw(image, title, plot_width_ + std::max(8, W / 120), bar_y0 - title_px * 2, title_px, kText);
+  const std::string title = options_.surface ? std::string() : quantity_title(quantity_, run_.nbody, log_density_);
+  if (!title.empty()) font_.draw(image, title, plot_width_ + std::max(8, W / 120), bar_y0 - title_px * 2, title_px, kText);
   if (log_density_ || run_.nbody)
     font_.draw(image, log_density_ ? "mass / length², log scale" : "G = 1 units", plot_width_ + std::max(8, W / 120),
                bar_y0 - title_px * 2 + title_px + title_px / 3, tick_px, kText);

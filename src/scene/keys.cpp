@@ -28,6 +28,7 @@ namespace {
 // The name tables, found by the enum's type.
 constexpr std::span<const EnumName<Precision>> names_of(Precision) { return kPrecisionNames; }
 constexpr std::span<const EnumName<Units>> names_of(Units) { return kUnitsNames; }
+constexpr std::span<const EnumName<SurfaceFormat>> names_of(SurfaceFormat) { return kSurfaceFormatNames; }
 constexpr std::span<const EnumName<TimeSteps>> names_of(TimeSteps) { return kTimeStepsNames; }
 constexpr std::span<const EnumName<OutputFormat>> names_of(OutputFormat) { return kOutputFormatNames; }
 constexpr std::span<const EnumName<sph::PressureForm>> names_of(sph::PressureForm) { return sph::kPressureFormNames; }
@@ -584,6 +585,27 @@ std::vector<SceneKey> declare_scene_keys() {
                             "array names at least one and none twice",
                      .type_doc = "string or array of strings"},
             in_scene(&Scene::formats)));
+  // The surface keys change files beside the frames, never the run: not hashed.
+  add(field(SceneKey{.key = "output.surface", .section = "output", .noun = "surface format",
+                     .doc = "`\"ply\"` writes the fluid's surface with each frame, `surface_NNNNNN.ply` (binary "
+                            "triangle mesh with normals, for Blender and ParaView; series in `surface.ply.series`); "
+                            "needs `[sph]` and a `\"vtp\"` or `\"hdf5\"` frame format (docs/surface.md)",
+                     .hashed = false},
+            in_scene(&Scene::surface)));
+  add(field(SceneKey{.key = "output.surface_radius", .section = "output", .unit = "particle spacings",
+                     .range = Range{0.5, 8, false, false},
+                     .doc = "the surface's smoothing-kernel radius, in particle spacings (m/ρ0)^(1/3)",
+                     .hashed = false},
+            in_scene(&Scene::surface_radius)));
+  add(field(SceneKey{.key = "output.surface_cell", .section = "output", .unit = "particle spacings",
+                     .range = Range{0.05, 4, false, false},
+                     .doc = "the surface's grid cell, in particle spacings (finer: smoother, slower)",
+                     .hashed = false},
+            in_scene(&Scene::surface_cell)));
+  add(field(SceneKey{.key = "output.surface_iso", .section = "output", .range = Range{0, 1, true, true},
+                     .doc = "the level of the colour field the surface is drawn at (`0.5`: where a flat fluid ends)",
+                     .hashed = false},
+            in_scene(&Scene::surface_iso)));
   return k;
 }
 

@@ -109,6 +109,17 @@ class Checker {
                        s_.sph->smoothing_length + s_.sph->grid_skin, keys));
   }
 
+  void output() const {
+    if (s_.surface == SurfaceFormat::None) return;
+    if (!s_.sph)
+      fail("output.surface", "the surface is the fluid's: it needs an [sph] section, and this scene has no fluid "
+                             "(remove output.surface, or draw the particles with swirl render)");
+    const auto& f = s_.formats;
+    if (std::find(f.begin(), f.end(), OutputFormat::Vtp) == f.end() &&
+        std::find(f.begin(), f.end(), OutputFormat::Hdf5) == f.end())
+      fail("output.surface", "is made from the frames: output.format must include \"vtp\" or \"hdf5\"");
+  }
+
   void sources() const {
     if (s_.sources.empty()) fail("particles", "no particles: the scene needs at least one [[particles]] source");
     std::uint64_t total = 0;
@@ -271,6 +282,7 @@ void validate(const Scene& scene) {
   check.box();
   check.nbody();
   check.sph();
+  check.output();
   check.sources();
 }
 

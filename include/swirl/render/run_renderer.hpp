@@ -12,7 +12,9 @@
 //             free-fall speed √(2|g|H) across the box height H, hydrostatic
 //             pressure ρ0|g|H, ±3 % of the rest density;
 //   gravity runs coloured by density show log10 of the surface density Σ,
-//             over four decades below the first frame's peak.
+//             over four decades below the first frame's peak;
+//   --surface: the fluid's surface mesh (fluid_surface.hpp) drawn as water
+//             (water.hpp) instead of splats, without a colour bar.
 // Each picture: splats (or Σ), the box's edges, the time in the top-left
 // corner and a colour bar with its units on the right.
 #pragma once
@@ -28,6 +30,7 @@
 #include "swirl/core/box.hpp"
 #include "swirl/io/pvd.hpp"
 #include "swirl/render/camera.hpp"
+#include "swirl/render/fluid_surface.hpp"
 #include "swirl/render/font.hpp"
 #include "swirl/render/frame.hpp"
 #include "swirl/render/image.hpp"
@@ -41,6 +44,7 @@ struct RenderOptions {
   std::optional<Quantity> color;                 // default: density for gravity runs, else speed
   int width = 1280, height = 720;                // pixels, each ≥ 64
   std::optional<std::pair<double, double>> range;  // colour range (log10 Σ for the gravity density view)
+  bool surface = false;                          // the fluid as a water surface (fluid_surface.hpp, water.hpp)
 };
 
 // What a run directory says about itself.
@@ -53,6 +57,7 @@ struct RunInfo {
   Vec3d gravity{};                    // uniform gravity, m/s²
   double rest_density = 0;            // SPH ρ0, kg/m³ (0: not a fluid)
   std::string scene_name;             // the scene file's stem, for captions
+  FluidSurface surface;               // the surface's settings (ρ0 and the scene's output.surface_* keys)
 };
 
 // Reads particles.pvd (or lists particles_*.vtp) and scene.toml. Throws

@@ -33,6 +33,8 @@ namespace swirl::scene {
 
 enum class Precision { Float, Double };
 enum class OutputFormat { Vtp, Csv, Hdf5 };
+// output.surface: the fluid's surface mesh per frame (render/surface_mesh.hpp), or none.
+enum class SurfaceFormat { None, Ply };
 // The unit system of a scene's numbers: SI (m, s, kg; G = 6.67430e-11
 // m³ kg⁻¹ s⁻²) or N-body units (G = 1, Hénon units for the stellar models).
 enum class Units { SI, NBody };
@@ -43,6 +45,8 @@ enum class TimeSteps { Global, Block };
 inline constexpr std::array<EnumName<Precision>, 2> kPrecisionNames{{{"float", Precision::Float}, {"double", Precision::Double}}};
 inline constexpr std::array<EnumName<OutputFormat>, 3> kOutputFormatNames{
     {{"vtp", OutputFormat::Vtp}, {"csv", OutputFormat::Csv}, {"hdf5", OutputFormat::Hdf5}}};
+inline constexpr std::array<EnumName<SurfaceFormat>, 2> kSurfaceFormatNames{
+    {{"none", SurfaceFormat::None}, {"ply", SurfaceFormat::Ply}}};
 inline constexpr std::array<EnumName<Units>, 2> kUnitsNames{{{"si", Units::SI}, {"nbody", Units::NBody}}};
 inline constexpr std::array<EnumName<TimeSteps>, 2> kTimeStepsNames{
     {{"global", TimeSteps::Global}, {"block", TimeSteps::Block}}};
@@ -185,6 +189,13 @@ struct Scene {
 
   double output_interval = 0;              // output.interval, s of simulated time; 0 = first and last frame only
   std::vector<OutputFormat> formats{OutputFormat::Vtp};  // output.format: "vtp", "csv" and/or "hdf5"
+  // The fluid's surface per frame (SPH scenes only): output.surface, and the
+  // reconstruction's kernel radius, grid cell (both in particle spacings,
+  // (m/ρ0)^(1/3)) and iso level (docs/surface.md).
+  SurfaceFormat surface = SurfaceFormat::None;
+  double surface_radius = 2.0;             // output.surface_radius, spacings
+  double surface_cell = 0.5;               // output.surface_cell, spacings
+  double surface_iso = 0.5;                // output.surface_iso, in (0, 1)
 
   std::vector<ParticleSource> sources;     // [[particles]]; a "fluid_block" becomes a LatticeSource
                                            // whose mass gives the rest density (sph::lattice_mass_for_density)

@@ -1,0 +1,190 @@
+// The fluid surface: the colour field's iso-surface on particles (closed,
+// oriented, the right volume and height, bit-identical for any thread count)
+// and its PLY file.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <numbers>
+#include <utility>
+#include <vector>
+
+#include "render/render_test_util.hpp"
+#include "swirl/io/atomic_file.hpp"
+#include "swirl/parallel/for_blocks.hpp"
+#include "swirl/render/ply.hpp"
+#include "swirl/render/surface_mesh.hpp"
+
+namespace swirl::render {
+namespace {
+
+// Lattice points s·(i, j, k) inside a sphere of `radius` around `centre`.
+std::vector<Vec3d> lattice_sphere(double s, double radius, Vec3d centre) {
+  std::vector<Vec3d> out;
+  const int n = static_cast<int>(std::ceil(radius / s)) + 1;
+  for (int k = -n; k <= n; ++k)
+    for (int j = -n; j <= n; ++j)
+      for (int i = -n; i <= n; ++i) {
+        const Vec3d d{s * i, s * j, s * k};
+        if (dot(d, d) < radius * radius) out.push_back(centre + d);
+      }
+  return out;
+}
+
+// Every undirected edge in exactly two triangles, every directed edge in one
+// (a closed, consistently oriented mesh); no degenerate index triple.
+void expect_closed(const SurfaceMesh& mesh) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const std::uint32_t* v = &mesh.indices[3 * t];
+    ASSERT_TRUE(v[0] != v[1] && v[1] != v[2] && v[0] != v[2]) << "triangle " << t;
+    for (int e = 0; e < 3; ++e) ++directed[{v[e], v[(e + 1) % 3]}];
+  }
+  std::size_t bad = 0;
+  for (const auto& [edge, count] : directed) {
+    const auto back = directed.find({edge.second, edge.first});
+    if (count != 1 || back == directed.end() || back->second != 1) ++bad;
+  }
+  EXPECT_EQ(bad, 0u) << "edges not shared by exactly two oppositely oriented triangles, of " << directed.size();
+}
+
+TEST(SurfaceMesh, SphereOfFluidIsClosedAndHoldsTheFluidsVolume) {
+  const double s = 0.01, radius = 12 * s;
+  const auto positions = lattice_sphere(s, radius, {0.3, -0.2, 0.5});
+  const std::vector<double> volume{s * s * s};
+  const SurfaceMesh mesh = reconstruct_surface(positions, volume, surface_params_for_spacing(s));
+  ASSERT_GT(mesh.triangle_count(), 1000u);
+  expect_closed(mesh);
+  const double fluid = static_cast<double>(positions.size()) * volume[0];
+  const double enclosed = enclosed_volume(mesh);
+  std::printf("sphere of %zu particles: mesh volume / fluid volume = %.5f, %zu triangles\n", positions.size(),
+              enclosed / fluid, mesh.triangle_count());
+  EXPECT_NEAR(enclosed / fluid, 1.0, 0.02) << positions.size() << " particles, fluid " << fluid << " m³, mesh "
+                                           << enclosed << " m³";
+  // Normals point outwards: away from the centre.
+  for (std::size_t v = 0; v < mesh.vertices.size(); v += 97) {
+    const Vec3d d = mesh.vertices[v].cast<double>() - Vec3d{0.3, -0.2, 0.5};
+    EXPECT_GT(dot(d, mesh.normals[v].cast<double>()), 0.9 * norm(d)) << v;
+  }
+}
+
+TEST(SurfaceMesh, FlatSurfaceLiesHalfASpacingAboveTheTopLayer) {
+  // A slab 24 × 24 × 8 particles at s·(i + ½): the fluid fills z in [0, 8s].
+  const double s = 0.02;
+  std::vector<Vec3d> positions;
+  for (int k = 0; k < 8; ++k)
+    for (int j = 0; j < 24; ++j)
+      for (int i = 0; i < 24; ++i) positions.push_back({s * (i + 0.5), s * (j + 0.5), s * (k + 0.5)});
+  const std::vector<double> volume{s * s * s};
+  const SurfaceMesh mesh = reconstruct_surface(positions, volume, surface_params_for_spacing(s));
+  expect_closed(mesh);
+  // Top and bottom faces, away from the rounded edges: at 8s and 0 within 2 % of s.
+  int top = 0, bottom = 0;
+  for (std::size_t v = 0; v < mesh.vertices.size(); ++v) {
+    const Vec3d p = mesh.vertices[v].cast<double>();
+    if (std::abs(p.x - 12 * s) > 6 * s || std::abs(p.y - 12 * s) > 6 * s) continue;
+    if (p.z > 4 * s) {
+      EXPECT_NEAR(p.z, 8 * s, 0.02 * s) << v;
+      EXPECT_GT(mesh.normals[v].z, 0.999f);
+      ++top;
+    } else {
+      EXPECT_NEAR(p.z, 0.0, 0.02 * s) << v;
+      EXPECT_LT(mesh.normals[v].z, -0.999f);
+      ++bottom;
+    }
+  }
+  EXPECT_GT(top, 100);
+  EXPECT_GT(bottom, 100);
+  // The slab's volume, less what its rounded edges and corners lose.
+  const double fluid = static_cast<double>(positions.size()) * volume[0];
+  std::printf("slab: mesh volume / fluid volume = %.5f\n", enclosed_volume(mesh) / fluid);
+  EXPECT_NEAR(enclosed_volume(mesh) / fluid, 1.0, 0.03);
+}
+
+TEST(SurfaceMesh, BitIdenticalForOneAndTwoThreads) {
+  // A jittered blob, with per-particle volumes.
+  const double s = 0.01;
+  std::vector<Vec3d> positions = lattice_sphere(s, 9 * s, {0, 0, 0});
+  std::vector<double> volumes(positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const double u = std::sin(12.9898 * static_cast<double>(i)) * 0.3;
+    positions[i] += Vec3d{u * s, -u * 0.5 * s, u * 0.7 * s};
+    volumes[i] = s * s * s * (1.0 + 0.1 * u);
+  }
+  const int saved = parallel::thread_count();
+  std::vector<SurfaceMesh> meshes;
+  for (int threads : {1, 2, 3}) {
+    parallel::set_thread_count(threads);
+    meshes.push_back(reconstruct_surface(positions, volumes, surface_params_for_spacing(s, 2.0, 0.4)));
+  }
+  parallel::set_thread_count(saved);
+  ASSERT_GT(meshes[0].triangle_count(), 100u);
+  for (std::size_t m = 1; m < meshes.size(); ++m) {
+    ASSERT_EQ(meshes[m].vertices.size(), meshes[0].vertices.size());
+    ASSERT_EQ(meshes[m].indices, meshes[0].indices);
+    EXPECT_EQ(std::memcmp(meshes[m].vertices.data(), meshes[0].vertices.data(), meshes[0].vertices.size() * sizeof(Vec3<float>)), 0);
+    EXPECT_EQ(std::memcmp(meshes[m].normals.data(), meshes[0].normals.data(), meshes[0].normals.size() * sizeof(Vec3<float>)), 0);
+    EXPECT_EQ(encode_ply(meshes[m], 1.5), encode_ply(meshes[0], 1.5));
+  }
+}
+
+TEST(SurfaceMesh, CoarsensTheGridToStayWithinMaxNodes) {
+  const double s = 0.01;
+  auto positions = lattice_sphere(s, 5 * s, {0, 0, 0});
+  positions.push_back({1.0, 1.0, 1.0});  // a lone far particle stretches the bounds
+  SurfaceParams params = surface_params_for_spacing(s);
+  params.max_nodes = 1u << 20;
+  const ColorField field = color_field(positions, std::vector<double>{s * s * s}, params);
+  EXPECT_LE(field.value.size(), params.max_nodes);
+  EXPECT_GT(field.cell, params.cell_size);
+  EXPECT_TRUE(reconstruct_surface({}, std::vector<double>{1.0}, params).indices.empty());
+  EXPECT_THROW(color_field(positions, std::vector<double>{1, 2}, params), std::invalid_argument);
+  params.iso = 1.0;
+  EXPECT_THROW(reconstruct_surface(positions, std::vector<double>{1.0}, params), std::invalid_argument);
+}
+
+TEST(SurfacePly, RoundTripsItsHeaderAndData) {
+  test::TempDir dir;
+  const double s = 0.01;
+  const SurfaceMesh mesh =
+      reconstruct_surface(lattice_sphere(s, 5 * s, {0.1, 0.2, 0.3}), std::vector<double>{s * s * s}, surface_params_for_spacing(s));
+  const auto path = dir.path / "surface_000007.ply";
+  write_ply(path, mesh, 0.125);
+  const std::string bytes = io::read_text_file(path);
+  const std::string header = bytes.substr(0, bytes.find("end_header\n") + 11);
+  EXPECT_EQ(header.rfind("ply\nformat binary_little_endian 1.0\n", 0), 0u);
+  EXPECT_NE(header.find("element vertex " + std::to_string(mesh.vertices.size()) + "\n"), std::string::npos) << header;
+  EXPECT_NE(header.find("element face " + std::to_string(mesh.triangle_count()) + "\n"), std::string::npos) << header;
+  EXPECT_NE(header.find("property list uchar uint vertex_indices\n"), std::string::npos);
+  EXPECT_EQ(bytes.size(), header.size() + 24 * mesh.vertices.size() + 13 * mesh.triangle_count());
+  // The first vertex's x, by hand (little-endian float).
+  float x0 = 0;
+  unsigned char le[4];
+  std::memcpy(le, bytes.data() + header.size(), 4);
+  const std::uint32_t bits = le[0] | (le[1] << 8) | (le[2] << 16) | (std::uint32_t{le[3]} << 24);
+  std::memcpy(&x0, &bits, 4);
+  EXPECT_EQ(x0, mesh.vertices[0].x);
+  EXPECT_EQ(static_cast<unsigned char>(bytes[header.size() + 24 * mesh.vertices.size()]), 3u);
+
+  const PlyFile back = read_ply(path);
+  EXPECT_EQ(back.time, 0.125);
+  EXPECT_EQ(back.mesh.iso, mesh.iso);
+  EXPECT_EQ(back.mesh.vertices, mesh.vertices);
+  EXPECT_EQ(back.mesh.normals, mesh.normals);
+  EXPECT_EQ(back.mesh.indices, mesh.indices);
+  EXPECT_DOUBLE_EQ(enclosed_volume(back.mesh), enclosed_volume(mesh));
+
+  // A truncated file is refused with its name.
+  io::write_file_atomic(dir.path / "cut.ply", bytes.substr(0, bytes.size() - 5));
+  try {
+    read_ply(dir.path / "cut.ply");
+    FAIL() << "read a truncated file";
+  } catch (const io::IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.ply"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace swirl::render
