@@ -131,7 +131,7 @@ bench: build
 	./build/swirl bench bh-opt --out $(BENCH_OUT)/bh-opt
 	/usr/bin/python3 tools/update_performance.py --results $(BENCH_OUT)
 
-asan-test: deps browser-deps
+asan-test: deps
 	cmake --preset asan
 	cmake --build --preset asan -j $(JOBS)
 	ctest --preset asan
