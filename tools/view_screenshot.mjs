@@ -5,6 +5,7 @@
 //
 //   node tools/view_screenshot.mjs --swirl build/swirl --scene examples/dam_break.toml \
 //        --time 0.4 --out docs/images/view_dam_break.png [--set key=value]... [--yaw 0.6 --pitch 0.35 --zoom 1.5]
+//        [--open-after SECONDS]
 import { spawn } from "node:child_process";
 import fs from "node:fs";
 import { createRequire } from "node:module";
@@ -34,6 +35,9 @@ try {
   let url = null;
   for (let i = 0; i < 600 && !url; i++) { url = stdout.match(/live at (http:\/\/\S+)/)?.[1] ?? null; if (!url) await sleep(100); }
   if (!url) throw new Error("swirl view printed no address");
+  // --open-after S: let the run go S seconds before the page opens (Chromium's
+  // software rendering would otherwise take the cores the run needs).
+  await sleep(1000 * Number(arg("open-after", "0")));
   browser = await puppeteer.launch({ executablePath: chromium, headless: true, protocolTimeout: 40 * 60_000,
     args: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--window-size=1000,640"],
     defaultViewport: { width: 1000, height: 640 } });
