@@ -46,12 +46,20 @@ const Communicator& Communicator::world() {
   return w != nullptr ? *w : single_rank;
 }
 
+#if SWIRL_WITH_MPI
+namespace {
+// One in-place allreduce over every rank: sum, min and max are this call with
+// their own type and operation.
+void allreduce_in_place(void* values, std::size_t count, MPI_Datatype type, MPI_Op op, const char* name) {
+  check(MPI_Allreduce(MPI_IN_PLACE, values, as_count(count, name), type, op, MPI_COMM_WORLD),
+        (std::string("MPI_Allreduce(") + name + ")").c_str());
+}
+}  // namespace
+#endif
+
 void Communicator::sum(std::span<std::uint64_t> values) const {
 #if SWIRL_WITH_MPI
-  if (mpi_ && !values.empty())
-    check(MPI_Allreduce(MPI_IN_PLACE, values.data(), as_count(values.size(), "sum"), MPI_UINT64_T, MPI_SUM,
-                        MPI_COMM_WORLD),
-          "MPI_Allreduce(sum)");
+  if (mpi_ && !values.empty()) allreduce_in_place(values.data(), values.size(), MPI_UINT64_T, MPI_SUM, "sum");
 #else
   (void)values;
 #endif
@@ -59,10 +67,7 @@ void Communicator::sum(std::span<std::uint64_t> values) const {
 
 void Communicator::min(std::span<double> values) const {
 #if SWIRL_WITH_MPI
-  if (mpi_ && !values.empty())
-    check(MPI_Allreduce(MPI_IN_PLACE, values.data(), as_count(values.size(), "min"), MPI_DOUBLE, MPI_MIN,
-                        MPI_COMM_WORLD),
-          "MPI_Allreduce(min)");
+  if (mpi_ && !values.empty()) allreduce_in_place(values.data(), values.size(), MPI_DOUBLE, MPI_MIN, "min");
 #else
   (void)values;
 #endif
@@ -70,10 +75,7 @@ void Communicator::min(std::span<double> values) const {
 
 void Communicator::max(std::span<double> values) const {
 #if SWIRL_WITH_MPI
-  if (mpi_ && !values.empty())
-    check(MPI_Allreduce(MPI_IN_PLACE, values.data(), as_count(values.size(), "max"), MPI_DOUBLE, MPI_MAX,
-                        MPI_COMM_WORLD),
-          "MPI_Allreduce(max)");
+  if (mpi_ && !values.empty()) allreduce_in_place(values.data(), values.size(), MPI_DOUBLE, MPI_MAX, "max");
 #else
   (void)values;
 #endif
