@@ -3,6 +3,7 @@
 // and its PLY file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -101,6 +102,42 @@ TEST(SurfaceMesh, FlatSurfaceLiesHalfASpacingAboveTheTopLayer) {
   const double fluid = static_cast<double>(positions.size()) * volume[0];
   std::printf("slab: mesh volume / fluid volume = %.5f\n", enclosed_volume(mesh) / fluid);
   EXPECT_NEAR(enclosed_volume(mesh) / fluid, 1.0, 0.03);
+}
+
+// The slow twin of color_field's slab-wise accumulation: at every grid node,
+// c = Σ_j V_j W(|x − x_j|, R) over all particles, poly6 W = 315/(64πR³)(1 − r²/R²)³,
+// summed directly in double. The fast field stores floats: equal to float
+// rounding of the largest value.
+TEST(SurfaceMesh, ColorFieldEqualsTheDirectSumAtEveryNode) {
+  const double s = 0.01;
+  std::vector<Vec3d> positions = lattice_sphere(s, 4 * s, {0.3, -0.2, 0.1});
+  std::vector<double> volumes(positions.size());
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const double u = std::sin(78.233 * static_cast<double>(i + 1));
+    positions[i] += Vec3d{0.4 * u * s, -0.3 * u * s, 0.2 * u * s};
+    volumes[i] = s * s * s * (1.0 + 0.2 * u);
+  }
+  const SurfaceParams params = surface_params_for_spacing(s, 2.0, 0.5);
+  const ColorField field = color_field(positions, volumes, params);
+  ASSERT_GT(field.nx * field.ny * field.nz, 1000);
+  const double R = params.kernel_radius;
+  const double norm = 315.0 / (64.0 * std::numbers::pi * R * R * R);
+  double largest = 0, worst = 0;
+  for (int k = 0; k < field.nz; ++k)
+    for (int j = 0; j < field.ny; ++j)
+      for (int i = 0; i < field.nx; ++i) {
+        const Vec3d x = field.origin + Vec3d{field.cell * i, field.cell * j, field.cell * k};
+        double c = 0;
+        for (std::size_t p = 0; p < positions.size(); ++p) {
+          const Vec3d d = x - positions[p];
+          const double q = 1.0 - dot(d, d) / (R * R);
+          if (q > 0) c += volumes[p] * norm * q * q * q;
+        }
+        largest = std::max(largest, c);
+        worst = std::max(worst, std::abs(c - static_cast<double>(field.at(i, j, k))));
+      }
+  EXPECT_GT(largest, 0.5);  // the blob's inside is near 1
+  EXPECT_LT(worst, 1e-5 * largest) << "largest node value " << largest;
 }
 
 TEST(SurfaceMesh, BitIdenticalForOneAndTwoThreads) {
