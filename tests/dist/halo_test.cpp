@@ -11,7 +11,9 @@
 
 #include <algorithm>
 #include <cstring>
+#include <functional>
 #include <iostream>
+#include <ostream>
 #include <numeric>
 #include <set>
 #include <vector>
@@ -44,8 +46,14 @@ std::array<std::int64_t, 3> cell_coordinates(const spatial::KeyFrame& f, std::ui
 
 struct Case {
   spatial::CellOrder curve;
-  double skin;  // m
+  double skin;      // m
+  bool scattered;   // test::scatter(): one particle per six cells
 };
+
+void PrintTo(const Case& c, std::ostream* out) {
+  *out << (c.curve == spatial::CellOrder::Rows ? "rows" : "morton") << ", skin " << c.skin
+       << (c.scattered ? ", scattered" : ", lattice");
+}
 
 // One rank's state: its particles (own, and ghosts once inserted), keys, frame, cuts.
 struct Rank {
@@ -120,6 +128,10 @@ std::array<std::uint64_t, 2> check_halo(const Communicator& comm, const Rank& r,
   }
   std::vector<std::uint64_t> got;
   const auto gi = r.halo.global_index();
+  // The local array is the global order with gaps: own particles at their place among the ghosts.
+  EXPECT_TRUE(std::adjacent_find(gi.begin(), gi.end(), std::greater_equal<>()) == gi.end());
+  for (std::size_t i = 0; i < n; ++i) EXPECT_EQ(gi[own.begin + i], first + i);
+  EXPECT_TRUE(std::is_sorted(r.keys.begin(), r.keys.end()));
   for (std::size_t i = 0; i < gi.size(); ++i)
     if (i < own.begin || i >= own.end) got.push_back(gi[i]);
   EXPECT_EQ(got, want) << "rank " << comm.rank() << " of " << comm.size();
@@ -146,10 +158,12 @@ TEST_P(HaloTest, EqualsTheBruteForceSearchBeforeAndAfterMigration) {
   const test::Slice slice = test::initial_slice(comm);
   Rank r;
   test::fill_block(r.p, slice.first, slice.end);
+  if (c.scattered) test::scatter(r.p, slice.first);
   const std::size_t temperature = r.p.add_field("temperature", 1);
   for (std::size_t i = 0; i < r.p.size(); ++i) r.p.extra(temperature)[i] = 300.0 + double(r.p.id[i]);
   ParticleSet<double> all;
   test::fill_block(all, 0, kParticles);
+  if (c.scattered) test::scatter(all, 0);
   all.add_field("temperature", 1);
   for (std::size_t i = 0; i < all.size(); ++i) all.extra(temperature)[i] = 300.0 + double(all.id[i]);
 
@@ -209,20 +223,22 @@ TEST_P(HaloTest, EqualsTheBruteForceSearchBeforeAndAfterMigration) {
   comm.sum(totals);
   if (comm.is_root())
     std::cout << "[figures] ranks " << comm.size() << (c.curve == spatial::CellOrder::Rows ? " rows" : " morton")
-              << " skin " << c.skin / kSpacing << " spacings: ghosts " << double(totals[0]) / double(kParticles)
+              << " skin " << c.skin / kSpacing << " spacings" << (c.scattered ? ", scattered" : "") << ": ghosts " << double(totals[0]) / double(kParticles)
               << " per particle (within h+skin " << double(totals[1]) / double(kParticles) << ", after the step "
               << double(totals[2]) / double(kParticles) << "); per rank: insert " << totals[3] / comm.size()
-              << " B in " << double(totals[6]) / comm.size() << " messages, refresh (density) "
+              << " B in " << double(totals[6]) / comm.size() << " messages, refresh (2 fields) "
               << totals[4] / comm.size() << " B, requests " << totals[5] / comm.size() << " B\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(Frames, HaloTest,
-                         ::testing::Values(Case{spatial::CellOrder::Rows, 0.0},
-                                           Case{spatial::CellOrder::Morton, 0.0},
-                                           Case{spatial::CellOrder::Rows, 0.3 * kSpacing}),
+                         ::testing::Values(Case{spatial::CellOrder::Rows, 0.0, false},
+                                           Case{spatial::CellOrder::Morton, 0.0, false},
+                                           Case{spatial::CellOrder::Rows, 0.3 * kSpacing, false},
+                                           Case{spatial::CellOrder::Rows, 0.0, true},
+                                           Case{spatial::CellOrder::Morton, 0.3 * kSpacing, true}),
                          [](const ::testing::TestParamInfo<Case>& param) {
                            return std::string(param.param.curve == spatial::CellOrder::Rows ? "Rows" : "Morton") +
-                                  (param.param.skin > 0 ? "Skin" : "");
+                                  (param.param.skin > 0 ? "Skin" : "") + (param.param.scattered ? "Scattered" : "");
                          });
 
 TEST(Halo, RefusesWhatItCannotPlace) {
