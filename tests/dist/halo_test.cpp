@@ -223,7 +223,8 @@ TEST_P(HaloTest, EqualsTheBruteForceSearchBeforeAndAfterMigration) {
   comm.sum(totals);
   if (comm.is_root())
     std::cout << "[figures] ranks " << comm.size() << (c.curve == spatial::CellOrder::Rows ? " rows" : " morton")
-              << " skin " << c.skin / kSpacing << " spacings" << (c.scattered ? ", scattered" : "") << ": ghosts " << double(totals[0]) / double(kParticles)
+              << " skin " << c.skin / kSpacing << " spacings" << (c.scattered ? ", scattered" : "")
+              << ": ghosts " << double(totals[0]) / double(kParticles)
               << " per particle (within h+skin " << double(totals[1]) / double(kParticles) << ", after the step "
               << double(totals[2]) / double(kParticles) << "); per rank: insert " << totals[3] / comm.size()
               << " B in " << double(totals[6]) / comm.size() << " messages, refresh (2 fields) "

@@ -171,7 +171,9 @@ class Halo {
   struct Selection {
     std::vector<AlignedVector<Real>*> reals;
     std::vector<AlignedVector<typename ParticleSet<Real>::int_type>*> ints;
-    std::size_t bytes() const { return reals.size() * sizeof(Real) + ints.size() * sizeof(typename ParticleSet<Real>::int_type); }
+    std::size_t bytes() const {
+      return reals.size() * sizeof(Real) + ints.size() * sizeof(typename ParticleSet<Real>::int_type);
+    }
   };
   template <class Real>
   static Selection<Real> select(ParticleSet<Real>& p, const std::vector<std::string>& fields);
