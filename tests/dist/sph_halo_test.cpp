@@ -2,9 +2,10 @@
 // run by CTest on 1-4 ranks: every own particle's density, pressure and
 // acceleration are byte-identical to a one-rank computation of the whole set,
 // which each rank computes itself. For float and double, row-major and Morton
-// cells, the scalar passes and the explicit-SIMD copy of every instruction set
-// this CPU runs, with and without the gradient correction; then again after a
-// step that moves particles across the cuts (migration, new ghosts).
+// cells (and rows of h + skin), the scalar passes and the explicit-SIMD copy of
+// every instruction set this CPU runs, with and without the gradient
+// correction; then again after a step that moves particles across the cuts
+// (migration, new ghosts), the ranks then on two threads each.
 #include "swirl/sph/halo_passes.hpp"
 
 #include <gtest/gtest.h>
@@ -18,6 +19,7 @@
 #include "swirl/core/simd_dispatch.hpp"
 #include "swirl/dist/key_cuts.hpp"
 #include "swirl/dist/key_order.hpp"
+#include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/cell_grid.hpp"
 #include "swirl/spatial/particle_order.hpp"
 #include "swirl/sph/grid_passes.hpp"
@@ -136,6 +138,14 @@ std::uint64_t differing(const Values<Real>& got, const Values<Real>& want, std::
   return bad;
 }
 
+struct ThreadCount {
+  explicit ThreadCount(int n) : saved(parallel::thread_count()) { parallel::set_thread_count(n); }
+  ~ThreadCount() { parallel::set_thread_count(saved); }
+  ThreadCount(const ThreadCount&) = delete;
+  ThreadCount& operator=(const ThreadCount&) = delete;
+  int saved;
+};
+
 template <class Real>
 class SphHaloTest : public ::testing::Test {};
 using Precisions = ::testing::Types<float, double>;
@@ -145,14 +155,24 @@ TYPED_TEST(SphHaloTest, OwnParticlesAreTheOneRankBitsBeforeAndAfterMigration) {
   using Real = TypeParam;
   const Communicator& comm = Communicator::world();
   const test::Slice slice = test::initial_slice(comm);
-  for (const spatial::CellOrder curve : {spatial::CellOrder::Rows, spatial::CellOrder::Morton}) {
-    for (const bool corrected : {false, true}) {
-      const sph::SphParameters params = parameters(corrected);
+  struct Cells {
+    spatial::CellOrder curve;
+    double skin;  // m: cells of h + skin
+    bool corrected;
+  };
+  const double skin = 0.3 * test::kSpacing;
+  for (const Cells cells : {Cells{spatial::CellOrder::Rows, 0, false}, Cells{spatial::CellOrder::Rows, 0, true},
+                            Cells{spatial::CellOrder::Morton, 0, false}, Cells{spatial::CellOrder::Morton, 0, true},
+                            Cells{spatial::CellOrder::Rows, skin, false}}) {
+    {
+      const sph::SphParameters params = parameters(cells.corrected);
       const sph::SphLaws<Real> laws(params);
-      const spatial::OrderRequest request{true, spatial::SortedCellGrid<Real>::cell_length_for(test::kH, 0), 0, curve};
+      const spatial::OrderRequest request{
+          true, spatial::SortedCellGrid<Real>::cell_length_for(test::kH, cells.skin), 0, cells.curve};
       for (const Path& path : paths()) {
-        SCOPED_TRACE(std::string(curve == spatial::CellOrder::Rows ? "rows" : "morton") +
-                     (corrected ? ", corrected, " : ", ") + path.name());
+        SCOPED_TRACE(std::string(cells.curve == spatial::CellOrder::Rows ? "rows" : "morton") +
+                     (cells.skin > 0 ? " of h + skin" : "") + (cells.corrected ? ", corrected, " : ", ") +
+                     path.name());
         ParticleSet<Real> all, mine;
         test::fill_block(all, 0, test::kParticles);
         test::fill_block(mine, slice.first, slice.end);
@@ -163,6 +183,8 @@ TYPED_TEST(SphHaloTest, OwnParticlesAreTheOneRankBitsBeforeAndAfterMigration) {
         for (int step = 0; step < 2; ++step) {
           std::uint64_t want_pairs = 0, got_pairs = 0;
           const Values<Real> want = one_rank(all, order, laws, path, want_pairs);
+          // The second step on two threads per rank: the own range's blocks, not the bits, change.
+          const ThreadCount threads(step == 0 ? 1 : 2);
           const Values<Real> got = with_ghosts(comm, mine, first, cuts, request, laws, path, got_pairs);
           const std::uint64_t bad = comm.sum(differing(got, want, first));
           EXPECT_EQ(bad, 0u) << "step " << step << ": own particles whose density, pressure or acceleration "
