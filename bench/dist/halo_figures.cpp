@@ -86,7 +86,8 @@ int run(int argc, char** argv) {
   const std::vector<std::uint64_t> cuts =
       dist::balanced_cut_keys(comm, keys, std::vector<std::uint64_t>(keys.size(), 1));
   const dist::Distribution d = dist::distribute_in_key_order(comm, p, keys, first, cuts);
-  dist::Halo halo = dist::Halo::find(comm, frame, keys, d.first_global_index, d.global_count, cuts, 7);
+  dist::Halo halo = dist::Halo::find(comm, frame, keys, d.first_global_index, d.global_count, cuts,
+                                          7);  // sph::kHaloTail<double>
   halo.insert(comm, p, keys, {"position", "velocity", "mass"});
   halo.refresh(comm, p, {"density", "pressure"});
 

@@ -242,6 +242,33 @@ INSTANTIATE_TEST_SUITE_P(Frames, HaloTest,
                                   (param.param.skin > 0 ? "Skin" : "") + (param.param.scattered ? "Scattered" : "");
                          });
 
+// Five particles, all on rank 0 at the start: with more ranks some own none,
+// and the global tail (15 > 5) makes every rank hold all five, in order.
+TEST(Halo, TheTailReachesEveryRankEvenEmptyOnes) {
+  const Communicator& comm = Communicator::world();
+  ParticleSet<double> p(comm.is_root() ? 5 : 0);
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    p.position.x[i] = 0.1 * double(4 - i);  // reversed: the sort moves them
+    p.id[i] = i;
+  }
+  bool fits = false;
+  const spatial::KeyFrame frame = global_key_frame(comm, p, {true, 0.01, 0, spatial::CellOrder::Rows}, fits);
+  ASSERT_TRUE(fits);
+  std::vector<std::uint64_t> keys = keys_in_frame(frame, p);
+  const std::vector<std::uint64_t> cuts = balanced_cut_keys(comm, keys, std::vector<std::uint64_t>(keys.size(), 1));
+  const Distribution d = distribute_in_key_order(comm, p, keys, 0, cuts);
+  Halo halo = Halo::find(comm, frame, keys, d.first_global_index, d.global_count, cuts, 15);
+  halo.insert(comm, p, keys);
+  ASSERT_EQ(p.size(), 5u);
+  for (std::size_t i = 0; i < 5; ++i) {
+    EXPECT_EQ(halo.global_index()[i], i);
+    EXPECT_EQ(p.id[i], 4 - i);
+  }
+  halo.remove(p, keys);
+  EXPECT_EQ(p.size(), halo.owned_count());
+  EXPECT_EQ(comm.sum(std::uint64_t(p.size())), 5u);
+}
+
 TEST(Halo, RefusesWhatItCannotPlace) {
   const Communicator& comm = Communicator::world();
   ParticleSet<double> p(3);
