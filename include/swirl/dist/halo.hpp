@@ -238,7 +238,6 @@ Halo::Selection<Real> Halo::select(ParticleSet<Real>& p, const std::vector<std::
 template <class Real>
 void Halo::insert(const Communicator& comm, ParticleSet<Real>& p, std::vector<std::uint64_t>& keys,
                   const std::vector<std::string>& fields) {
-  using Int = typename ParticleSet<Real>::int_type;
   if (inserted_) throw std::logic_error("halo: the ghosts are in already");
   const std::size_t n = p.size();
   if (n != owned_count_ || keys.size() != n)
@@ -307,11 +306,7 @@ void Halo::insert(const Communicator& comm, ParticleSet<Real>& p, std::vector<st
       get(at, global_index_[slot]);
       get(at, p.id[slot]);
       for (auto* a : sel.reals) get(at, (*a)[slot]);
-      for (auto* a : sel.ints) {
-        Int v;
-        get(at, v);
-        (*a)[slot] = v;
-      }
+      for (auto* a : sel.ints) get(at, (*a)[slot]);
     }
   }
   for (std::size_t i = 1; i < m; ++i)
