@@ -8,8 +8,9 @@ independent. A module missing from the table fails the check, so a new module
 must be placed in it.
 
 The ranks are the layering that holds today (lowest first). docs name the
-coarse layers core; parallel; spatial, io, dist; force, integrate, boundary, sph,
-gravity; scene; sim; render, view; CLI. Within the solver layer the includes are
+coarse layers core; parallel; spatial, io; dist; force, integrate, boundary, sph,
+gravity; scene; sim; render, view; CLI. dist sits above spatial: the ghosts
+of a rank (dist/halo.hpp) are found in the particle order's key frame and cells. Within the solver layer the includes are
 finer: the steppers (integrate) apply the box (boundary) and return the
 step's scan (force/step_scan.hpp); sph and gravity implement the Solver seam
 (force) and gravity's benchmark steps with a stepper (integrate). So
@@ -25,15 +26,16 @@ import sys
 RANK = {
     "core": 0,
     "parallel": 1,
-    "spatial": 2, "io": 2, "dist": 2,
-    "boundary": 3,
-    "force": 4,
-    "integrate": 5,
-    "sph": 6, "gravity": 6,
-    "scene": 7,
-    "sim": 8,
-    "render": 9, "view": 9,
-    "apps": 10,  # apps/swirl: the CLI, above everything
+    "spatial": 2, "io": 2,
+    "dist": 3,
+    "boundary": 4,
+    "force": 5,
+    "integrate": 6,
+    "sph": 7, "gravity": 7,
+    "scene": 8,
+    "sim": 9,
+    "render": 10, "view": 10,
+    "apps": 11,  # apps/swirl: the CLI, above everything
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]swirl/([A-Za-z0-9_]+)/', re.MULTILINE)

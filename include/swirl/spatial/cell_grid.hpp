@@ -70,8 +70,25 @@ class SortedCellGrid {
   // uses another search.
   bool view(const ParticleOrder<Real>& order, std::size_t block_size) {
     if (!order.valid() || !order.cells_fit() || !(order.request().cell_length > 0)) return false;
-    const KeyFrame& f = order.frame();
-    const auto keys = order.keys();
+    view(order.frame(), order.keys(), {}, block_size);
+    return true;
+  }
+
+  // The same view of particles that someone else put in a cell frame's key
+  // order: f is a frame made for a cell request that fit
+  // (ParticleOrder::frame_for), keys the particles' sorted keys in it. A
+  // rank's particles with their ghosts (dist/halo.hpp) are a slice of the
+  // global order with gaps: global_index[i] (increasing) is particle i's index
+  // in that order, and neighbouring cells' ranges are merged only where they
+  // are contiguous there, so that the ranges are the one-rank ones restricted
+  // to the particles present (an explicit-SIMD pass starts a batch at each
+  // range). Empty global_index: the particles are the whole order. keys and
+  // global_index must outlive the view.
+  void view(const KeyFrame& f, std::span<const std::uint64_t> keys, std::span<const std::uint64_t> global_index,
+            std::size_t block_size) {
+    if (!global_index.empty() && global_index.size() != keys.size())
+      throw std::invalid_argument("cell grid: one global index per key is needed");
+    global_ = global_index;
     n_ = keys.size();
     order_ = f.curve;
     cell_ = f.cell_length();
@@ -101,7 +118,6 @@ class SortedCellGrid {
       throw std::invalid_argument("cell grid: a dense cell table (sph.grid.table = \"dense\") would need " +
                                   std::to_string(key_count_) + " entries, more than 2^31; use \"auto\" or \"hashed\"");
     index(block_size);
-    return true;
   }
 
   // Fills out with the ranges of the 27 cells around `key` (non-empty ones
@@ -155,7 +171,8 @@ class SortedCellGrid {
   }
 
   // The 27 cells' keys in increasing order (so the ranges come in memory
-  // order), one range each, merged where one ends where the next begins.
+  // order), one range each, merged where one ends where the next begins
+  // (and, with global indices, where they are contiguous in the global order).
   int morton_ranges(std::uint64_t key, NeighbourRanges& out) const {
     const std::uint64_t c[3] = {morton_compact(key), morton_compact(key >> 1), morton_compact(key >> 2)};
     std::uint64_t spread[3][3];
@@ -180,7 +197,9 @@ class SortedCellGrid {
       const std::uint64_t k = near[static_cast<std::size_t>(q)];
       const auto [b, e] = cell_range(k);
       if (b >= e) continue;
-      if (count > 0 && out[static_cast<std::size_t>(count - 1)].end == b)
+      const bool touches = count > 0 && out[static_cast<std::size_t>(count - 1)].end == b &&
+                           (global_.empty() || global_[b - 1] + 1 == global_[b]);
+      if (touches)
         out[static_cast<std::size_t>(count - 1)].end = e;
       else
         out[static_cast<std::size_t>(count++)] = {b, e};
@@ -225,6 +244,7 @@ class SortedCellGrid {
   std::uint64_t key_count_ = 1;  // the dense table's keys
   std::array<std::uint64_t, 3> dims_{1, 1, 1};
   bool dense_ = true;
+  std::span<const std::uint64_t> global_;     // the particles' global indices (empty: the identity)
   std::span<const std::uint64_t> cell_keys_;  // the order's keys, or shifted_
   AlignedVector<std::uint64_t> shifted_;      // Morton cell keys when a cell is several key quanta
   std::vector<std::uint32_t> start_;  // dense: cells + 1 entries

@@ -263,30 +263,38 @@ class ParticleOrder {
     return out;
   }
 
-  KeyFrame make_frame(const Bounds& b) {
+  KeyFrame make_frame(const Bounds& b) { return frame_for(request_, b.lo, b.hi, cells_fit_); }
+
+ public:
+  // The key frame update() uses for particles whose bounding box is [lo, hi]
+  // (per axis, in double) under `request`; cells_fit tells whether a cell
+  // request could be honoured. A pure function: a distributed run computes the
+  // one-rank frame from the global box (dist/halo.hpp).
+  static KeyFrame frame_for(const OrderRequest& request, const std::array<double, 3>& lo,
+                            const std::array<double, 3>& hi, bool& cells_fit) {
     KeyFrame f;
-    f.corner = b.lo;
-    const double extent = std::max({b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]});
-    const double length = request_.cell_length;
-    cells_fit_ = true;
+    f.corner = lo;
+    const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    const double length = request.cell_length;
+    cells_fit = true;
     if (length > 0) {
       std::uint64_t widest = 1;
       for (std::size_t a = 0; a < 3; ++a) {
-        const double span = (b.hi[a] - b.lo[a]) / length;
+        const double span = (hi[a] - lo[a]) / length;
         if (!(span < double(std::uint64_t{1} << KeyFrame::kBitsPerAxis) - 1)) {
-          cells_fit_ = false;
+          cells_fit = false;
           break;
         }
         f.cells[a] = static_cast<std::uint64_t>(std::floor(span)) + 1;
         widest = std::max(widest, f.cells[a]);
       }
-      if (cells_fit_ && request_.curve == CellOrder::Rows) {
+      if (cells_fit && request.curve == CellOrder::Rows) {
         f.curve = CellOrder::Rows;
         f.quantum = length;
         f.key_bits = std::max(1u, static_cast<unsigned>(std::bit_width(f.cells[0] * f.cells[1] * f.cells[2] - 1)));
         return f;
       }
-      if (cells_fit_) {
+      if (cells_fit) {
         f.cell_shift = KeyFrame::kBitsPerAxis - static_cast<unsigned>(std::bit_width(widest - 1));
         f.quantum = std::ldexp(length, -static_cast<int>(f.cell_shift));
         return f;
@@ -299,6 +307,7 @@ class ParticleOrder {
     return f;
   }
 
+ private:
   void remember(ParticleSet<Real>& p, std::size_t block_size) {
     const std::size_t ref = p.add_field(std::string(kReferenceField), 3, FieldUse::Internal);
     parallel::for_blocks_pinned("order_remember", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {

@@ -35,8 +35,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
+#include "swirl/core/index_range.hpp"
 #include "swirl/core/kernel_path.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/simd_dispatch.hpp"
@@ -88,14 +90,32 @@ void for_each_in_cells(const spatial::SortedCellGrid<Real>& grid, std::size_t b,
   });
 }
 
+// Every particle of p, as an IndexRange.
+template <class Real>
+IndexRange all_of(const ParticleSet<Real>& p) {
+  return {0, static_cast<std::uint32_t>(p.size())};
+}
+
+inline void check_range(IndexRange only, std::size_t n) {
+  if (only.begin > only.end || only.end > n)
+    throw std::invalid_argument("SPH grid pass: the particles to compute are not a range of the particles");
+}
+
 }  // namespace detail
 
 // Density and pressure of every particle; returns the neighbour pairs found
 // (self excluded), for the mean neighbour count.
+//
+// `only` (the overloads with it): computes particles [only.begin, only.end)
+// alone, reading the others as neighbours (a rank's own particles among its
+// ghosts, dist/halo.hpp); the scratch still has one entry per particle. Each
+// particle's result is the same bits as in a pass over all.
 template <class Real>
 std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
-                           std::size_t block_size, GridScratch<Real>& scratch, KernelPath path) {
+                           std::size_t block_size, GridScratch<Real>& scratch, KernelPath path, IndexRange only) {
   const std::size_t n = p.size();
+  detail::check_range(only, n);
+  const std::size_t from = only.begin, todo = only.end - only.begin;
   scratch.volume.resize(n);
   scratch.pressure_volume.resize(n);
   Real *volume = scratch.volume.data(), *pressure_volume = scratch.pressure_volume.data();
@@ -109,10 +129,10 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
     a.volume = volume, a.pressure_volume = pressure_volume, a.n = n;
     a.laws = laws;
     return parallel::reduce_blocks_pinned(
-        "sph_grid_density", n, block_size, std::uint64_t{0},
+        "sph_grid_density", todo, block_size, std::uint64_t{0},
         [&](std::size_t b, std::size_t e) {
           std::uint64_t pairs = 0;
-          detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
+          detail::for_each_cell(grid, from + b, from + e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
             pairs += density_cell_simd(a, first, last, ranges.data(), count);
           });
           return pairs;
@@ -120,7 +140,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
         sum_blocks);
   } else {
     return parallel::reduce_blocks_pinned(
-        "sph_grid_density", n, block_size, std::uint64_t{0},
+        "sph_grid_density", todo, block_size, std::uint64_t{0},
         [&](std::size_t b, std::size_t e) {
           // A copy in the block: the stores below cannot alias it, so its
           // constants stay in registers and the pair loop has no load of them
@@ -128,7 +148,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
           // slower natively: g++ no longer vectorised the pair loop).
           const SphLaws<Real> law = laws;
           std::uint64_t pairs = 0;
-          detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+          detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
             Real sum = 0;
             std::uint64_t found = 0;
             for (int r = 0; r < count; ++r)
@@ -152,19 +172,29 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
   }
 }
 
+template <class Real>
+std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
+                           std::size_t block_size, GridScratch<Real>& scratch, KernelPath path) {
+  return grid_density(grid, p, laws, block_size, scratch, path, detail::all_of(p));
+}
+
 // The gradient correction L_i = M_i⁻¹ of every particle (laws.correction,
 // sph/laws.hpp) into scratch.correction, from the volumes grid_density() left.
 // One scalar pass over the same pairs; run only when laws.corrected.
 template <class Real>
 void grid_gradient_correction(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& p,
-                              const SphLaws<Real>& laws, std::size_t block_size, GridScratch<Real>& scratch) {
+                              const SphLaws<Real>& laws, std::size_t block_size, GridScratch<Real>& scratch,
+                              IndexRange only) {
   const std::size_t n = p.size();
+  detail::check_range(only, n);
+  const std::size_t from = only.begin;
   for (auto& c : scratch.correction) c.resize(n);
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
   const Real* V = scratch.volume.data();
-  parallel::for_blocks_pinned("sph_grid_correction", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+  const std::size_t todo = only.end - only.begin;
+  parallel::for_blocks_pinned("sph_grid_correction", todo, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     const SphLaws<Real> law = laws;
-    detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
       Real m6[6] = {};
       for (int r = 0; r < count; ++r)
         for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j) {
@@ -181,14 +211,22 @@ void grid_gradient_correction(const spatial::SortedCellGrid<Real>& grid, const P
   });
 }
 
+template <class Real>
+void grid_gradient_correction(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& p,
+                              const SphLaws<Real>& laws, std::size_t block_size, GridScratch<Real>& scratch) {
+  grid_gradient_correction(grid, p, laws, block_size, scratch, detail::all_of(p));
+}
+
 // Adds the pressure and viscosity accelerations (densities, pressures and the
 // scratch from grid_density(); with laws.corrected also grid_gradient_correction()'s): per pair PressureLaw::term · r⃗ and
 // ViscosityLaw::term · (v_j − v_i) summed, SphLaws::acceleration() once per
 // particle.
 template <class Real>
 void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
-                 std::size_t block_size, const GridScratch<Real>& scratch, KernelPath path) {
+                 std::size_t block_size, const GridScratch<Real>& scratch, KernelPath path, IndexRange only) {
   const std::size_t n = p.size();
+  detail::check_range(only, n);
+  const std::size_t from = only.begin, todo = only.end - only.begin;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
   const Real *V = scratch.volume.data(), *PV = scratch.pressure_volume.data(), *pr = p.pressure.data();
@@ -203,8 +241,8 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
     a.laws = laws;
     if (laws.corrected)
       for (int k = 0; k < 6; ++k) a.correction[k] = scratch.correction[static_cast<std::size_t>(k)].data();
-    parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
-      detail::for_each_cell(grid, b, e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
+    parallel::for_blocks_pinned("sph_grid_forces", todo, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_cell(grid, from + b, from + e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
         forces_cell_simd(a, first, last, ranges.data(), count);
       });
     });
@@ -214,7 +252,7 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
   struct Sums {
     Real px = 0, py = 0, pz = 0, vx = 0, vy = 0, vz = 0;
   };
-  parallel::for_blocks_pinned("sph_grid_forces", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+  parallel::for_blocks_pinned("sph_grid_forces", todo, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     const SphLaws<Real> law = laws;  // a copy in the block, as in grid_density (no reloads)
     auto pair = [&](std::size_t i, std::size_t j, Sums& s) {
       const Real dx = x[i] - x[j], dy = y[i] - y[j], dz = z[i] - z[j];
@@ -231,7 +269,7 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
       s.vy += fv * (vy[j] - vy[i]);
       s.vz += fv * (vz[j] - vz[i]);
     };
-    detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
       Sums s;
       for (int r = 0; r < count; ++r)
         for (std::size_t j = ranges[static_cast<std::size_t>(r)].begin; j < ranges[static_cast<std::size_t>(r)].end; ++j)
@@ -247,6 +285,12 @@ void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p
       az[i] += law.acceleration(s.pz, s.vz, inv_rho);
     });
   });
+}
+
+template <class Real>
+void grid_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
+                 std::size_t block_size, const GridScratch<Real>& scratch, KernelPath path) {
+  grid_forces(grid, p, laws, block_size, scratch, path, detail::all_of(p));
 }
 
 }  // namespace swirl::sph

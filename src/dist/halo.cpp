@@ -1,0 +1,132 @@
+#include "swirl/dist/halo.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <stdexcept>
+
+#include "swirl/core/morton.hpp"
+#include "swirl/dist/key_order.hpp"
+
+namespace swirl::dist {
+
+namespace {
+
+// Calls visit(cell key) for the cells SortedCellGrid scans around `cell`: the
+// 27 around it (itself included) clipped to the frame's cells per axis, as
+// its row_ranges() and morton_ranges() loops do.
+template <class Visit>
+void for_each_neighbour_cell(const spatial::KeyFrame& f, std::uint64_t cell, Visit&& visit) {
+  const std::uint64_t nx = f.cells[0], ny = f.cells[1], nz = f.cells[2];
+  std::uint64_t c[3];
+  const bool rows = f.curve == spatial::CellOrder::Rows;
+  if (rows) {
+    c[0] = cell % nx;
+    c[1] = (cell / nx) % ny;
+    c[2] = cell / nx / ny;
+  } else {
+    c[0] = morton_compact(cell);
+    c[1] = morton_compact(cell >> 1);
+    c[2] = morton_compact(cell >> 2);
+  }
+  for (std::uint64_t z = c[2] > 0 ? c[2] - 1 : 0; z <= std::min(c[2] + 1, nz - 1); ++z)
+    for (std::uint64_t y = c[1] > 0 ? c[1] - 1 : 0; y <= std::min(c[1] + 1, ny - 1); ++y)
+      for (std::uint64_t x = c[0] > 0 ? c[0] - 1 : 0; x <= std::min(c[0] + 1, nx - 1); ++x)
+        visit(rows ? (z * ny + y) * nx + x : morton_key(x, y, z));
+}
+
+Bytes to_bytes(const std::vector<std::uint64_t>& values) {
+  Bytes b(values.size() * sizeof(std::uint64_t));
+  if (!values.empty()) std::memcpy(b.data(), values.data(), b.size());
+  return b;
+}
+
+std::vector<std::uint64_t> from_bytes(const Bytes& b) {
+  if (b.size() % sizeof(std::uint64_t) != 0) throw std::runtime_error("halo: a rank sent a partial cell request");
+  std::vector<std::uint64_t> values(b.size() / sizeof(std::uint64_t));
+  if (!values.empty()) std::memcpy(values.data(), b.data(), b.size());
+  return values;
+}
+
+}  // namespace
+
+Traffic Halo::traffic_of(const std::vector<Bytes>& send, int self) {
+  Traffic t;
+  for (std::size_t d = 0; d < send.size(); ++d) {
+    if (static_cast<int>(d) == self || send[d].empty()) continue;
+    t.bytes += send[d].size();
+    ++t.messages;
+  }
+  return t;
+}
+
+Halo Halo::find(const Communicator& comm, const spatial::KeyFrame& frame, std::span<const std::uint64_t> keys,
+                std::uint64_t first_global_index, std::uint64_t global_count, std::span<const std::uint64_t> cut_keys,
+                std::size_t tail) {
+  const auto ranks = static_cast<std::size_t>(comm.size());
+  if (cut_keys.size() + 1 != ranks) throw std::invalid_argument("halo: size()-1 cut keys are needed");
+  if (!std::is_sorted(keys.begin(), keys.end())) throw std::invalid_argument("halo: the keys must be sorted");
+  if (keys.size() > 0xffffffffu) throw std::invalid_argument("halo: more than 2^32 - 1 particles on one rank");
+  Halo h;
+  h.rank_ = comm.rank();
+  h.first_ = first_global_index;
+  h.owned_count_ = keys.size();
+  h.owned_ = {0, static_cast<std::uint32_t>(keys.size())};
+  h.send_.assign(ranks, {});
+  h.recv_count_.assign(ranks, 0);
+
+  // A cell's particle keys: [cell << shift, cell << shift | low) (Rows: the cell key itself).
+  const unsigned shift = frame.curve == spatial::CellOrder::Rows ? 0u : 3u * frame.cell_shift;
+  const std::uint64_t low = shift == 0 ? 0 : (std::uint64_t{1} << shift) - 1;
+
+  // The cells this rank needs from each other rank: around each of its occupied cells.
+  std::vector<std::vector<std::uint64_t>> want(ranks);
+  bool any = false;
+  std::uint64_t previous = 0;
+  for (const std::uint64_t key : keys) {
+    const std::uint64_t cell = frame.cell_of(key);
+    if (any && cell == previous) continue;
+    any = true;
+    previous = cell;
+    for_each_neighbour_cell(frame, cell, [&](std::uint64_t near) {
+      const std::uint64_t lo = near << shift, hi = lo | low;
+      const int from = owner_of(lo, cut_keys), to = owner_of(hi, cut_keys);
+      for (int o = from; o <= to; ++o)
+        if (o != h.rank_) want[static_cast<std::size_t>(o)].push_back(near);
+    });
+  }
+  std::vector<Bytes> requests(ranks);
+  for (std::size_t o = 0; o < ranks; ++o) {
+    std::sort(want[o].begin(), want[o].end());
+    want[o].erase(std::unique(want[o].begin(), want[o].end()), want[o].end());
+    requests[o] = to_bytes(want[o]);
+  }
+  h.request_traffic_ = traffic_of(requests, h.rank_);
+  const std::vector<Bytes> asked = comm.all_to_all(requests);
+
+  // The global last `tail` particles that this rank owns go to every other rank.
+  const std::uint64_t tail_from = global_count > tail ? global_count - tail : 0;
+  const std::uint64_t own_end = first_global_index + keys.size();
+  const std::size_t tail_begin =
+      static_cast<std::size_t>(std::clamp(tail_from, first_global_index, own_end) - first_global_index);
+
+  for (std::size_t s = 0; s < ranks; ++s) {
+    if (static_cast<int>(s) == h.rank_) continue;
+    std::vector<std::uint32_t>& out = h.send_[s];
+    // Cells come sorted, so their particles come in increasing memory order.
+    for (const std::uint64_t cell : from_bytes(asked[s])) {
+      const std::uint64_t lo = cell << shift, hi = lo | low;
+      const auto b = std::lower_bound(keys.begin(), keys.end(), lo);
+      const auto e = std::upper_bound(b, keys.end(), hi);
+      for (auto it = b; it != e; ++it) out.push_back(static_cast<std::uint32_t>(it - keys.begin()));
+    }
+    if (tail_begin < keys.size()) {
+      const std::size_t cells_end = out.size();
+      for (std::size_t i = tail_begin; i < keys.size(); ++i) out.push_back(static_cast<std::uint32_t>(i));
+      std::inplace_merge(out.begin(), out.begin() + static_cast<std::ptrdiff_t>(cells_end), out.end());
+      out.erase(std::unique(out.begin(), out.end()), out.end());
+    }
+  }
+  return h;
+}
+
+}  // namespace swirl::dist
