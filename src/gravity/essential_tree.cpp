@@ -810,6 +810,7 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
   LinearNodes<Real> t;
   resize_nodes(t, total);
   std::vector<std::uint8_t> complete(total, 1);
+  std::vector<std::uint8_t> imported(total, 0);  // 1: a record another rank sent, 2: another rank's root
   auto set_range = [&](std::size_t j, std::uint32_t gbegin, std::uint32_t gend) {
     t.begin[j] = local_slot(gbegin);
     t.end[j] = local_slot(gend);
@@ -833,6 +834,7 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
       continue;
     }
     const Import& im = imports[std::size_t(root.rank)];
+    imported[i] = 2;
     if (!im.root_opened[root.index]) {
       complete[i] = 0;  // never opened by this rank's walks: its expansion only
     } else if (root.child_count) {
@@ -854,6 +856,7 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
     const std::size_t base = import_base[std::size_t(s)];
     for (std::size_t c = 0; c < im.nodes.size(); ++c) {
       const std::size_t j = base + c;
+      imported[j] = 1;
       copy_expansion(im.nodes, c, t, j);
       t.level[j] = im.nodes.level[c];
       t.prefix[j] = 0;
@@ -872,7 +875,9 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
   for (std::size_t g = 0; g < groups.size(); ++g) groups[g] = own_index(own_groups[g]);
 
   // 9. This rank's walks replayed with the group walk's own test: every node
-  //    they open must have its children or its particles here.
+  //    they open must have its children or its particles here. (And what of
+  //    the import they use: the export's excess over the walks' needs.)
+  std::vector<std::uint8_t> used(total, 0);  // bit 0: visited, bit 1: opened as a leaf
   for (const std::uint32_t group : groups) {
     const std::uint32_t gb = t.begin[group], ge = t.end[group];
     Real lo[3] = {tx[gb], ty[gb], tz[gb]}, hi[3] = {tx[gb], ty[gb], tz[gb]};
@@ -889,6 +894,7 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
       const std::uint32_t node = stack.back();
       stack.pop_back();
       if (node == group) continue;
+      used[node] |= 1;
       if (!(t.begin[node] <= gb && ge <= t.end[node])) {
         const Real cx = t.com_x[node], cy = t.com_y[node], cz = t.com_z[node];
         const Real ex = std::max(std::max(lo[0] - cx, cx - hi[0]), Real(0));
@@ -899,10 +905,15 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
       if (!complete[node])
         throw std::logic_error("essential tree: a walk of rank " + std::to_string(rank) +
                                " opens a node another rank did not send");
+      if (imported[node] && t.child_count[node] == 0) used[node] |= 2;
       for (std::uint32_t c = 0; c < t.child_count[node]; ++c) stack.push_back(t.first_child[node] + c);
     }
   }
 
+  for (std::size_t j = 0; j < total; ++j) {
+    if (imported[j] == 1 && (used[j] & 1)) ++stats_.nodes_used;
+    if (imported[j] && (used[j] & 2)) stats_.particles_used += t.end[j] - t.begin[j];
+  }
   stats_.tree_nodes = total;
   stats_.tree_particles = tx.size();
   own_count_ = n;

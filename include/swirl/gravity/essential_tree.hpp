@@ -114,6 +114,8 @@ struct EssentialTreeStats {
   // The locally essential tree proper (all-to-all), to and from the other ranks.
   std::uint64_t nodes_sent = 0, particles_sent = 0, bytes_sent = 0;
   std::uint64_t nodes_received = 0, particles_received = 0, bytes_received = 0;
+  // Of those received, what this rank's walks visit (nodes) and open (leaves' particles).
+  std::uint64_t nodes_used = 0, particles_used = 0;
   // All-gathers (spanning counts, local roots, group boxes): bytes this rank received.
   std::uint64_t bytes_gathered = 0;
   // The assembled tree.
