@@ -645,8 +645,9 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
     std::uint64_t records = 0;
     for (std::size_t qi = 0; qi < queue.size(); ++qi) {
       const auto q = queue[qi];
+      // A copy: opened_by appends to lists.
+      const std::vector<std::uint32_t> visiting(lists.begin() + q[1], lists.begin() + q[2]);
       for (std::uint32_t c = own.first_child[q[0]]; c < own.first_child[q[0]] + own.child_count[q[0]]; ++c) {
-        const std::vector<std::uint32_t> visiting(lists.begin() + q[1], lists.begin() + q[2]);
         const bool opened = enqueue(opened_by(c, visiting));
         for (const Real v : {own.com_x[c], own.com_y[c], own.com_z[c], own.mass[c], own.qxx[c], own.qxy[c],
                              own.qxz[c], own.qyy[c], own.qyz[c], own.open2[c]})
