@@ -299,6 +299,42 @@ TEST(EssentialTreeScale, ExchangeVolumeOfALargerPlummerSphere) {
   report(comm, "plummer " + std::string(size) + ", defaults", tree.stats(), part.p.size());
 }
 
+// Ranks without particles: every particle on the first rank, then on the last.
+TEST(EssentialTreeCuts, RanksWithoutParticlesAndOneRankWithAll) {
+  const Communicator& comm = Communicator::world();
+  const ParticleSet<double> all = model<double>(Model::TwoBlobs);
+  LinearTreeSettings settings;
+  settings.group_size = 64;
+  const GravityField<double> ref = one_rank_field(all, settings);
+  for (const std::uint64_t cut : {~std::uint64_t(0), std::uint64_t(0)}) {
+    SCOPED_TRACE(cut == 0 ? "all on the last rank" : "all on the first rank");
+    Part<double> part = distribute(comm, all, settings);
+    const std::vector<std::uint64_t> cuts(part.cuts.size(), cut);
+    part.distribution = dist::distribute_in_key_order(comm, part.p, part.keys, part.distribution.first_global_index,
+                                                      cuts);
+    const int holder = cut == 0 ? comm.size() - 1 : 0;
+    EXPECT_EQ(part.p.size(), comm.rank() == holder ? all.size() : 0u);
+    EssentialTree<double> tree;
+    tree.build(comm, part.p, part.keys, part.distribution.first_global_index, cuts, part.cube, settings, 64);
+    GravityField<double> field;
+    tree.evaluate(field);
+    ASSERT_EQ(field.size(), part.p.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < part.p.size(); ++i) {
+      const std::size_t g = part.p.id[i];
+      differ += std::memcmp(&field.acceleration.x[i], &ref.acceleration.x[g], sizeof(double)) != 0 ||
+                        std::memcmp(&field.potential[i], &ref.potential[g], sizeof(double)) != 0
+                    ? 1
+                    : 0;
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(tree.stats().spanning_nodes, 0u);
+    // Ranks without groups open nothing (only the root's "not opened" flag travels).
+    const EssentialTreeStats& st = tree.stats();
+    EXPECT_EQ(st.nodes_sent + st.particles_sent + st.nodes_received + st.particles_received, 0u);
+  }
+}
+
 // Cuts on depth boundaries (balanced_cut_keys) can fall inside a group;
 // group_aligned_cuts moves them to group boundaries, and the tree refuses cuts
 // that split a group.
