@@ -136,6 +136,30 @@ std::vector<Bytes> Communicator::all_to_all(const std::vector<Bytes>& send) cons
   return send;
 }
 
+std::vector<Bytes> Communicator::all_gather(const Bytes& mine) const {
+#if SWIRL_WITH_MPI
+  if (mpi_) {
+    const auto n = static_cast<std::size_t>(size_);
+    const int count = as_count(mine.size(), "all_gather");
+    std::vector<int> counts(n), offsets(n);
+    check(MPI_Allgather(&count, 1, MPI_INT, counts.data(), 1, MPI_INT, MPI_COMM_WORLD), "MPI_Allgather(counts)");
+    std::size_t total = 0;
+    for (std::size_t s = 0; s < n; ++s) {
+      offsets[s] = as_count(total, "all_gather");
+      total += static_cast<std::size_t>(counts[s]);
+    }
+    Bytes flat(total);
+    check(MPI_Allgatherv(mine.data(), count, MPI_BYTE, flat.data(), counts.data(), offsets.data(), MPI_BYTE,
+                         MPI_COMM_WORLD),
+          "MPI_Allgatherv");
+    std::vector<Bytes> all(n);
+    for (std::size_t s = 0; s < n; ++s) all[s].assign(flat.begin() + offsets[s], flat.begin() + offsets[s] + counts[s]);
+    return all;
+  }
+#endif
+  return {mine};
+}
+
 std::vector<Bytes> Communicator::gather_to_root(const Bytes& mine) const {
 #if SWIRL_WITH_MPI
   if (mpi_) {

@@ -14,6 +14,7 @@
 #include "swirl/gravity/interaction_kernels.hpp"
 #include "swirl/gravity/pair_law.hpp"
 #include "swirl/parallel/for_blocks.hpp"
+#include "tree_moments.hpp"
 
 namespace swirl::gravity {
 
@@ -48,6 +49,142 @@ Real to_real_radius2(double r2) {
 
 }  // namespace
 
+KeyCube key_cube(const std::array<double, 3>& lo, const std::array<double, 3>& hi, std::size_t count) {
+  double side = count ? std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]}) : 0.0;
+  if (!(side > 0)) side = 1;  // coincident particles (or none): any cube will do
+  if (!std::isfinite(side)) throw std::invalid_argument("linear octree: non-finite particle positions");
+  KeyCube cube;
+  cube.side = side;
+  cube.corner = count ? lo : std::array<double, 3>{0, 0, 0};
+  return cube;
+}
+
+namespace detail {
+
+namespace {
+
+std::array<double, 3> cube_centre(std::uint8_t level, std::uint64_t prefix, const CubeFrame& frame) {
+  const double cell = frame.side / double(std::uint64_t(1) << level);
+  return {frame.corner[0] + (double(morton_compact(prefix)) + 0.5) * cell,
+          frame.corner[1] + (double(morton_compact(prefix >> 1)) + 0.5) * cell,
+          frame.corner[2] + (double(morton_compact(prefix >> 2)) + 0.5) * cell};
+}
+
+}  // namespace
+
+template <class Real>
+NodeMoments leaf_moments(const Real* x, const Real* y, const Real* z, const Real* m, std::uint32_t first,
+                         std::uint32_t last, std::uint8_t level, std::uint64_t prefix, const CubeFrame& frame,
+                         bool quadrupole) {
+  NodeMoments r{};
+  for (std::uint32_t s = first; s < last; ++s) {
+    r.m += double(m[s]);
+    r.x += double(m[s]) * double(x[s]);
+    r.y += double(m[s]) * double(y[s]);
+    r.z += double(m[s]) * double(z[s]);
+  }
+  if (last - first == 1) {  // exactly the particle
+    r.x = double(x[first]);
+    r.y = double(y[first]);
+    r.z = double(z[first]);
+  } else if (r.m != 0) {
+    r.x /= r.m;
+    r.y /= r.m;
+    r.z /= r.m;
+  } else {  // massless: at the cube's centre
+    const std::array<double, 3> centre = cube_centre(level, prefix, frame);
+    r.x = centre[0];
+    r.y = centre[1];
+    r.z = centre[2];
+  }
+  if (quadrupole && last - first > 1) {
+    for (std::uint32_t s = first; s < last; ++s) {
+      const double dx = double(x[s]) - r.x, dy = double(y[s]) - r.y, dz = double(z[s]) - r.z;
+      const double ms = double(m[s]), d2 = dx * dx + dy * dy + dz * dz;
+      r.xx += ms * (3 * dx * dx - d2);
+      r.xy += ms * 3 * dx * dy;
+      r.xz += ms * 3 * dx * dz;
+      r.yy += ms * (3 * dy * dy - d2);
+      r.yz += ms * 3 * dy * dz;
+    }
+  }
+  return r;
+}
+
+NodeMoments parent_moments(const NodeMoments* children, std::size_t count, std::uint8_t level, std::uint64_t prefix,
+                           const CubeFrame& frame, bool quadrupole) {
+  NodeMoments r{};
+  for (std::size_t c = 0; c < count; ++c) {
+    r.m += children[c].m;
+    r.x += children[c].m * children[c].x;
+    r.y += children[c].m * children[c].y;
+    r.z += children[c].m * children[c].z;
+  }
+  if (r.m != 0) {
+    r.x /= r.m;
+    r.y /= r.m;
+    r.z /= r.m;
+  } else {
+    const std::array<double, 3> centre = cube_centre(level, prefix, frame);
+    r.x = centre[0];
+    r.y = centre[1];
+    r.z = centre[2];
+  }
+  if (quadrupole) {
+    // Parallel-axis theorem: a child's quadrupole about the parent's centre of mass.
+    for (std::size_t c = 0; c < count; ++c) {
+      const NodeMoments& k = children[c];
+      const double dx = k.x - r.x, dy = k.y - r.y, dz = k.z - r.z;
+      const double m = k.m, d2 = dx * dx + dy * dy + dz * dz;
+      r.xx += k.xx + m * (3 * dx * dx - d2);
+      r.xy += k.xy + m * 3 * dx * dy;
+      r.xz += k.xz + m * 3 * dx * dz;
+      r.yy += k.yy + m * (3 * dy * dy - d2);
+      r.yz += k.yz + m * 3 * dy * dz;
+    }
+  }
+  return r;
+}
+
+template <class Real>
+void store_node(const NodeMoments& r, std::uint8_t level, std::uint64_t prefix, const CubeFrame& frame,
+                const LinearTreeSettings& settings, LinearNodes<Real>& t, std::size_t node) {
+  t.com_x[node] = Real(r.x);
+  t.com_y[node] = Real(r.y);
+  t.com_z[node] = Real(r.z);
+  t.mass[node] = Real(r.m);
+  t.qxx[node] = Real(r.xx);
+  t.qxy[node] = Real(r.xy);
+  t.qxz[node] = Real(r.xz);
+  t.qyy[node] = Real(r.yy);
+  t.qyz[node] = Real(r.yz);
+  const double opening = settings.opening;
+  const double cell = frame.side / double(std::uint64_t(1) << level);
+  double radius = std::numeric_limits<double>::infinity();  // λ = 0 or θ = 0: always open
+  if (opening > 0) {
+    radius = cell / opening;
+    if (settings.criterion == Criterion::Barnes) {
+      const double dx = frame.corner[0] + (double(morton_compact(prefix)) + 0.5) * cell - r.x;
+      const double dy = frame.corner[1] + (double(morton_compact(prefix >> 1)) + 0.5) * cell - r.y;
+      const double dz = frame.corner[2] + (double(morton_compact(prefix >> 2)) + 0.5) * cell - r.z;
+      radius += std::sqrt(dx * dx + dy * dy + dz * dz);
+    }
+  }
+  t.open2[node] = to_real_radius2<Real>(radius * radius);
+}
+
+template NodeMoments leaf_moments<float>(const float*, const float*, const float*, const float*, std::uint32_t,
+                                         std::uint32_t, std::uint8_t, std::uint64_t, const CubeFrame&, bool);
+template NodeMoments leaf_moments<double>(const double*, const double*, const double*, const double*,
+                                          std::uint32_t, std::uint32_t, std::uint8_t, std::uint64_t,
+                                          const CubeFrame&, bool);
+template void store_node<float>(const NodeMoments&, std::uint8_t, std::uint64_t, const CubeFrame&,
+                                const LinearTreeSettings&, LinearNodes<float>&, std::size_t);
+template void store_node<double>(const NodeMoments&, std::uint8_t, std::uint64_t, const CubeFrame&,
+                                 const LinearTreeSettings&, LinearNodes<double>&, std::size_t);
+
+}  // namespace detail
+
 template <class Real>
 void LinearOctree<Real>::check(const ParticleSet<Real>& p, const LinearTreeSettings& settings,
                                std::size_t block_size) const {
@@ -62,6 +199,7 @@ void LinearOctree<Real>::build(const ParticleSet<Real>& p, const LinearTreeSetti
   check(p, settings, block_size);
   settings_ = settings;
   block_size_ = block_size;
+  assembled_ = false;
   make_keys(p, block_size);
   make_nodes();
   make_multipoles();
@@ -77,6 +215,7 @@ void LinearOctree<Real>::build_sorted(const ParticleSet<Real>& p, std::span<cons
   if (!(side > 0) || !std::isfinite(side)) throw std::invalid_argument("linear octree: the key cube's side must be > 0");
   settings_ = settings;
   block_size_ = block_size;
+  assembled_ = false;
   corner_ = corner;
   side_ = side;
   keys_ = sorted_keys;
@@ -135,26 +274,16 @@ void LinearOctree<Real>::make_keys(const ParticleSet<Real>& p, std::size_t block
         return Bounds{std::min(a[0], b[0]), std::min(a[1], b[1]), std::min(a[2], b[2]),
                       std::max(a[3], b[3]), std::max(a[4], b[4]), std::max(a[5], b[5])};
       });
-  double side = n ? std::max({bounds[3] - bounds[0], bounds[4] - bounds[1], bounds[5] - bounds[2]}) : 0.0;
-  if (!(side > 0)) side = 1;  // coincident particles (or none): any cube will do
-  if (!std::isfinite(side)) throw std::invalid_argument("linear octree: non-finite particle positions");
-  side_ = side;
-  corner_ = n ? std::array<double, 3>{bounds[0], bounds[1], bounds[2]} : std::array<double, 3>{0, 0, 0};
+  const KeyCube cube = key_cube({bounds[0], bounds[1], bounds[2]}, {bounds[3], bounds[4], bounds[5]}, n);
+  side_ = cube.side;
+  corner_ = cube.corner;
 
-  constexpr double cells = double(std::uint64_t(1) << kLevels);
-  const double scale = cells / side;
+  const double scale = key_scale(side_);
   raw_keys_.resize(n);
   parallel::for_blocks("linear_octree_keys", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
-    for (std::size_t i = b; i < e; ++i) {
-      std::uint64_t key = 0;
-      for (int a = 0; a < 3; ++a) {
-        const double c = std::floor((double(p.position[a][i]) - corner_[std::size_t(a)]) * scale);
-        // The far faces map to the last cell.
-        const std::uint64_t q = c >= cells ? std::uint64_t(cells - 1) : (c > 0 ? std::uint64_t(c) : 0);
-        key |= morton_spread(q) << a;
-      }
-      raw_keys_[i] = key;
-    }
+    for (std::size_t i = b; i < e; ++i)
+      raw_keys_[i] = octree_key(double(p.position.x[i]), double(p.position.y[i]), double(p.position.z[i]), corner_,
+                                scale);
   });
   sorter_.sort(raw_keys_, 3 * kLevels);
   keys_ = sorter_.keys();
@@ -270,10 +399,8 @@ void LinearOctree<Real>::make_multipoles() {
   LinearNodes<Real>& t = nodes_;
   const std::size_t count = t.size();
   // Moments in double while they are summed; stored in Real at the end.
-  struct Moments {
-    double m, x, y, z, xx, xy, xz, yy, yz;
-  };
-  std::vector<Moments> mom(count);
+  std::vector<detail::NodeMoments> mom(count);
+  const detail::CubeFrame frame{corner_, side_};
   // Nodes are stored level by level: find each level's range.
   std::vector<std::size_t> level_start(std::size_t(depth_) + 2, count);
   for (std::size_t node = count; node-- > 0;) level_start[t.level[node]] = node;
@@ -282,110 +409,74 @@ void LinearOctree<Real>::make_multipoles() {
     const std::size_t lb = level_start[std::size_t(level)], le = level_start[std::size_t(level) + 1];
     node_blocks("linear_octree_multipoles", le - lb, [&](std::size_t b, std::size_t e, std::size_t) {
       for (std::size_t node = lb + b; node < lb + e; ++node) {
-        const double cell = side_ / double(std::uint64_t(1) << t.level[node]);
-        const std::uint64_t prefix = t.prefix[node];
-        const double centre[3] = {corner_[0] + (double(morton_compact(prefix)) + 0.5) * cell,
-                                  corner_[1] + (double(morton_compact(prefix >> 1)) + 0.5) * cell,
-                                  corner_[2] + (double(morton_compact(prefix >> 2)) + 0.5) * cell};
-        Moments r{};
-        if (t.child_count[node] == 0) {
-          const std::uint32_t first = t.begin[node], last = t.end[node];
-          for (std::uint32_t s = first; s < last; ++s) {
-            r.m += double(m_[s]);
-            r.x += double(m_[s]) * double(x_[s]);
-            r.y += double(m_[s]) * double(y_[s]);
-            r.z += double(m_[s]) * double(z_[s]);
-          }
-          if (last - first == 1) {  // exactly the particle
-            r.x = double(x_[first]);
-            r.y = double(y_[first]);
-            r.z = double(z_[first]);
-          } else if (r.m != 0) {
-            r.x /= r.m;
-            r.y /= r.m;
-            r.z /= r.m;
-          } else {  // massless: at the cube's centre
-            r.x = centre[0];
-            r.y = centre[1];
-            r.z = centre[2];
-          }
-          if (quadrupole && last - first > 1) {
-            for (std::uint32_t s = first; s < last; ++s) {
-              const double dx = double(x_[s]) - r.x, dy = double(y_[s]) - r.y, dz = double(z_[s]) - r.z;
-              const double m = double(m_[s]), d2 = dx * dx + dy * dy + dz * dz;
-              r.xx += m * (3 * dx * dx - d2);
-              r.xy += m * 3 * dx * dy;
-              r.xz += m * 3 * dx * dz;
-              r.yy += m * (3 * dy * dy - d2);
-              r.yz += m * 3 * dy * dz;
-            }
-          }
-        } else {
-          const std::uint32_t c0 = t.first_child[node], c1 = c0 + t.child_count[node];
-          for (std::uint32_t c = c0; c < c1; ++c) {
-            r.m += mom[c].m;
-            r.x += mom[c].m * mom[c].x;
-            r.y += mom[c].m * mom[c].y;
-            r.z += mom[c].m * mom[c].z;
-          }
-          if (r.m != 0) {
-            r.x /= r.m;
-            r.y /= r.m;
-            r.z /= r.m;
-          } else {
-            r.x = centre[0];
-            r.y = centre[1];
-            r.z = centre[2];
-          }
-          if (quadrupole) {
-            // Parallel-axis theorem: a child's quadrupole about the parent's centre of mass.
-            for (std::uint32_t c = c0; c < c1; ++c) {
-              const double dx = mom[c].x - r.x, dy = mom[c].y - r.y, dz = mom[c].z - r.z;
-              const double m = mom[c].m, d2 = dx * dx + dy * dy + dz * dz;
-              r.xx += mom[c].xx + m * (3 * dx * dx - d2);
-              r.xy += mom[c].xy + m * 3 * dx * dy;
-              r.xz += mom[c].xz + m * 3 * dx * dz;
-              r.yy += mom[c].yy + m * (3 * dy * dy - d2);
-              r.yz += mom[c].yz + m * 3 * dy * dz;
-            }
-          }
-        }
-        mom[node] = r;
+        if (t.child_count[node] == 0)
+          mom[node] = detail::leaf_moments(x_.data(), y_.data(), z_.data(),
+                                           m_.data(), t.begin[node], t.end[node], t.level[node], t.prefix[node],
+                                           frame, quadrupole);
+        else
+          mom[node] = detail::parent_moments(mom.data() + t.first_child[node], t.child_count[node], t.level[node],
+                                             t.prefix[node], frame, quadrupole);
       }
     });
   }
 
   for (auto* a : {&t.com_x, &t.com_y, &t.com_z, &t.mass, &t.qxx, &t.qxy, &t.qxz, &t.qyy, &t.qyz, &t.open2})
     a->resize(count);
-  const double opening = settings_.opening;
-  const bool barnes = settings_.criterion == Criterion::Barnes;
   node_blocks("linear_octree_store", count, [&](std::size_t b, std::size_t e, std::size_t) {
-    for (std::size_t node = b; node < e; ++node) {
-      const Moments& r = mom[node];
-      t.com_x[node] = Real(r.x);
-      t.com_y[node] = Real(r.y);
-      t.com_z[node] = Real(r.z);
-      t.mass[node] = Real(r.m);
-      t.qxx[node] = Real(r.xx);
-      t.qxy[node] = Real(r.xy);
-      t.qxz[node] = Real(r.xz);
-      t.qyy[node] = Real(r.yy);
-      t.qyz[node] = Real(r.yz);
-      const double cell = side_ / double(std::uint64_t(1) << t.level[node]);
-      double radius = std::numeric_limits<double>::infinity();  // λ = 0 or θ = 0: always open
-      if (opening > 0) {
-        radius = cell / opening;
-        if (barnes) {
-          const std::uint64_t prefix = t.prefix[node];
-          const double dx = corner_[0] + (double(morton_compact(prefix)) + 0.5) * cell - r.x;
-          const double dy = corner_[1] + (double(morton_compact(prefix >> 1)) + 0.5) * cell - r.y;
-          const double dz = corner_[2] + (double(morton_compact(prefix >> 2)) + 0.5) * cell - r.z;
-          radius += std::sqrt(dx * dx + dy * dy + dz * dz);
-        }
-      }
-      t.open2[node] = to_real_radius2<Real>(radius * radius);
-    }
+    for (std::size_t node = b; node < e; ++node)
+      detail::store_node(mom[node], t.level[node], t.prefix[node], frame, settings_, t, node);
   });
+}
+
+template <class Real>
+void LinearOctree<Real>::assemble(LinearNodes<Real> nodes, std::span<const Real> x, std::span<const Real> y,
+                                  std::span<const Real> z, std::span<const Real> m, std::vector<std::uint32_t> groups,
+                                  const LinearTreeSettings& settings) {
+  if (settings.walk != Walk::Group) throw std::invalid_argument("linear octree: an assembled tree needs the group walk");
+  if (settings.group_size < 1 || settings.bucket_size < 1)
+    throw std::invalid_argument("linear octree: bucket and group sizes must be at least 1");
+  const std::size_t n = x.size();
+  if (y.size() != n || z.size() != n || m.size() != n)
+    throw std::invalid_argument("linear octree: assemble needs x, y, z and m of one length");
+  if (n >= npos) throw std::invalid_argument("linear octree: too many particles for 32-bit indices");
+  const std::size_t count = nodes.size();
+  for (const auto* a : {&nodes.com_x, &nodes.com_y, &nodes.com_z, &nodes.mass, &nodes.qxx, &nodes.qxy, &nodes.qxz,
+                        &nodes.qyy, &nodes.qyz, &nodes.open2})
+    if (a->size() != count) throw std::invalid_argument("linear octree: assemble needs every node array full");
+  if (nodes.end.size() != count || nodes.first_child.size() != count || nodes.child_count.size() != count)
+    throw std::invalid_argument("linear octree: assemble needs every node array full");
+  for (std::size_t k = 0; k < count; ++k) {
+    if (nodes.begin[k] > nodes.end[k] || nodes.end[k] > n)
+      throw std::invalid_argument("linear octree: assemble: a node's range is outside the particles");
+    if (nodes.child_count[k] != 0 && (nodes.first_child[k] <= k || nodes.first_child[k] + nodes.child_count[k] > count))
+      throw std::invalid_argument("linear octree: assemble: a node's children are outside the nodes");
+  }
+  for (const std::uint32_t g : groups)
+    if (g >= count || nodes.begin[g] == nodes.end[g])
+      throw std::invalid_argument("linear octree: assemble: a group is not a node with particles");
+  settings_ = settings;
+  assembled_ = true;
+  nodes_ = std::move(nodes);
+  own_x_.assign(x.begin(), x.end());
+  own_y_.assign(y.begin(), y.end());
+  own_z_.assign(z.begin(), z.end());
+  own_m_.assign(m.begin(), m.end());
+  x_ = own_x_;
+  y_ = own_y_;
+  z_ = own_z_;
+  m_ = own_m_;
+  order_.resize(n);
+  std::iota(order_.begin(), order_.end(), std::uint32_t(0));
+  keys_ = {};
+  raw_keys_.clear();
+  corner_ = {0, 0, 0};
+  side_ = 0;
+  depth_ = 0;
+  for (const std::uint8_t l : nodes_.level) depth_ = std::max(depth_, int(l));
+  groups_ = std::move(groups);
+  schedule_.clear();
+  slot_cost_.clear();
+  group_counts_.clear();
 }
 
 template <class Real>
@@ -608,6 +699,7 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
 template <class Real>
 WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size, const ActiveSet& active) {
   const std::size_t n = x_.size();
+  if (assembled_ && !active.all()) throw std::invalid_argument("linear octree: an assembled tree evaluates every group");
   out.resize(n);
   active_slot_.clear();
   if (!active.all()) {

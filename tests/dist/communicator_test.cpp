@@ -45,6 +45,15 @@ TEST(Communicator, AllToAllDeliversEachBufferToItsRank) {
   }
 }
 
+TEST(Communicator, AllGatherGivesEveryRankEveryRanksBytesInRankOrder) {
+  const Communicator& comm = Communicator::world();
+  // Rank s contributes 3·s bytes of value s + 1 (rank 0: none).
+  const Bytes mine(3 * static_cast<std::size_t>(comm.rank()), std::byte(comm.rank() + 1));
+  const std::vector<Bytes> all = comm.all_gather(mine);
+  ASSERT_EQ(all.size(), static_cast<std::size_t>(comm.size()));
+  for (std::size_t s = 0; s < all.size(); ++s) EXPECT_EQ(all[s], Bytes(3 * s, std::byte(s + 1)));
+}
+
 TEST(Communicator, GatherToRootKeepsRankOrder) {
   const Communicator& comm = Communicator::world();
   Bytes mine(static_cast<std::size_t>(comm.rank()), std::byte(comm.rank()));

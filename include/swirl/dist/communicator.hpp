@@ -49,6 +49,9 @@ class Communicator {
   // here, indexed by source rank (send.size() must be size()).
   std::vector<Bytes> all_to_all(const std::vector<Bytes>& send) const;
 
+  // Every rank's bytes on every rank, in rank order (each rank's may differ in length).
+  std::vector<Bytes> all_gather(const Bytes& mine) const;
+
   // Every rank's bytes on rank 0, in rank order (other ranks get an empty list).
   std::vector<Bytes> gather_to_root(const Bytes& mine) const;
 

@@ -73,10 +73,15 @@
 // criterion's error and round-off, not bitwise. A fully active group is
 // computed exactly as in the full evaluation.
 //
+// Assembled trees: assemble() adopts nodes and particles made elsewhere — a
+// rank's locally essential tree (essential_tree.hpp) — and evaluate() runs the
+// group walk above over them, unchanged, for the groups it is given.
+//
 // Units: G = 1; lengths as the positions; side of the root cube = root_side().
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -85,6 +90,7 @@
 
 #include "swirl/core/active_set.hpp"
 #include "swirl/core/aligned.hpp"
+#include "swirl/core/morton.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/gravity/field.hpp"
 #include "swirl/gravity/pair_law.hpp"
@@ -103,6 +109,34 @@ struct LinearTreeSettings {
   std::size_t group_size = 256;  // the group walk's particles per group, at most (unless a leaf holds more)
   bool simd_kernels = true;     // group walk: false uses the kernels' scalar path (the reference)
 };
+
+// The key cube of build(): the low corner of the particles' bounding box and
+// its largest extent as side (1 when there are no particles or all coincide).
+struct KeyCube {
+  std::array<double, 3> corner{};
+  double side = 1;
+};
+
+// The key cube of `count` particles whose coordinates lie in [lo, hi] per
+// axis, exactly as build() makes it (so a cube from a global min/max over ranks
+// is the one-rank cube). Throws std::invalid_argument for a non-finite extent.
+KeyCube key_cube(const std::array<double, 3>& lo, const std::array<double, 3>& hi, std::size_t count);
+
+// The 63-bit Morton key of a position in a key cube, with the operations of
+// build(): 21 bits per axis, floor((x − corner)·2^21/side) clamped to the cube
+// (the far faces in the last cell). scale = key_scale(cube.side).
+inline double key_scale(double side) { return double(std::uint64_t(1) << 21) / side; }
+inline std::uint64_t octree_key(double x, double y, double z, const std::array<double, 3>& corner, double scale) {
+  constexpr double cells = double(std::uint64_t(1) << 21);
+  const double v[3] = {x, y, z};
+  std::uint64_t key = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double c = std::floor((v[a] - corner[std::size_t(a)]) * scale);
+    const std::uint64_t q = c >= cells ? std::uint64_t(cells - 1) : (c > 0 ? std::uint64_t(c) : 0);
+    key |= morton_spread(q) << a;
+  }
+  return key;
+}
 
 // The node arrays (SoA). Index n in every array is node n; node 0 is the root.
 template <class Real>
@@ -147,6 +181,19 @@ class LinearOctree {
   void build_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
                     const std::array<double, 3>& corner, double side, const LinearTreeSettings& settings,
                     std::size_t block_size);
+
+  // Adopts a tree assembled elsewhere (a rank's locally essential tree,
+  // essential_tree.hpp) for the group walk: nodes as nodes() describes them
+  // (children contiguous, in child order; [begin, end) ranges of the particles
+  // given here, nesting like the tree's; moments and open2 as build() stores
+  // them), the particles in slot order (copied), and the groups to evaluate
+  // (node indices, each node's particles all given). evaluate() then walks
+  // these groups only, over these nodes, with the group walk unchanged, and
+  // writes the field of their particles (indexed by slot; the other slots'
+  // entries are left as they were). Needs walk = group; evaluate() then takes
+  // no active set.
+  void assemble(LinearNodes<Real> nodes, std::span<const Real> x, std::span<const Real> y, std::span<const Real> z,
+                std::span<const Real> m, std::vector<std::uint32_t> groups, const LinearTreeSettings& settings);
 
   // Declares that the caller permuted its ParticleSet by order() (p.reorder):
   // ParticleSet index and sorted slot now coincide, order() becomes the identity.
@@ -221,6 +268,7 @@ class LinearOctree {
   std::vector<WalkCounts> group_counts_;
   std::vector<GroupLists> lists_;        // per thread
   std::vector<std::uint8_t> active_slot_;  // this evaluation's active flags per sorted slot (empty: all)
+  bool assembled_ = false;                 // assemble(): the groups are given, not made
 };
 
 extern template class LinearOctree<float>;
