@@ -71,17 +71,24 @@
 // boundaries: once; the flag travels in the solver's state, so a resume does
 // not recompute it). Then for a fluid particle i
 //   ρ_i += Σ_b ψ_b W_ib
-// and the pressure force is mirrored: the boundary particle has the fluid
-// particle's pressure and density, and in the thesis's pair law
-// (p_i V_j + p_j V_j) only the fluid particle's own term p_i V_b is kept, with
-// V_b = ψ_b/ρ0: a_i += ψ_b p_i/(ρ0 ρ_i) ∇W_ib (Akinci's −ψ_b p_i/ρ_i² ∇W_ib with
-// ρ0 for ρ_i in one factor, so that the SIMD passes stay as they are; with the
-// thesis's ½ the wall pushes, like the fluid, with half the pressure). The
-// viscosity treats a boundary particle as a neighbour at rest of volume ψ_b/ρ0
-// (no-slip walls). For DFSPH the same terms enter ρ, α and the pressure passes
-// (sph/dfsph_passes.hpp). A boundary particle's own density is reported as ρ0
-// and its pressure as 0; the fluid's diagnostics and the DFSPH errors count
-// fluid particles only. Boundary particles need the grid search.
+// and the pressure force is mirrored onto the wall. For DFSPH (sph/
+// dfsph_passes.hpp) as Akinci and SPlisHSPlasH do it: the pair (i, b) adds the
+// fluid particle's own term ψ_b (κ_i/ρ_i) ∇W_ib (κ/ρ = p/ρ²), to ρ, α and the
+// pressure passes alike. For the thesis's solver, whose pair law is
+// (p_i V_j + p_j V_j) with V = m/ρ, the boundary particle gets V_b = ψ_b/ρ0 and
+// the pressure p_b = Σ_f p_f W_bf / Σ_f W_bf, the Shepard average of the fluid
+// pressures around it (Adami et al. 2012's wall pressure without its
+// hydrostatic term): where the pressure is uniform the pair pushes with
+// 2 p_i V_b, as a fluid particle mirrored across the wall would. (The fluid's
+// own term alone, p_i V_b, let a particle of the dam break through a thin
+// plate at t = 0.38 s: the normal push of a sheet vanishes in its plane, and
+// the weakly compressible fluid behind squeezed it there.) These are per-
+// particle entries written between the density and the force pass, so the
+// SIMD force pass and its scalar twin run unchanged. The viscosity treats a
+// boundary particle as a neighbour at rest of volume ψ_b/ρ0 (no-slip walls).
+// A boundary particle's own density is reported as ρ0 and its pressure as 0
+// (DFSPH) or p_b (the thesis's); the fluid's diagnostics and the DFSPH errors
+// count fluid particles only. Boundary particles need the grid search.
 //
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
 // Every pass gathers into particle i only: deterministic for any thread count.
@@ -344,20 +351,40 @@ class SphFluid final : public Solver<Real> {
   // The thesis's passes with boundary particles: after the density pass, a
   // boundary particle's entries are set so that the force pass (scalar or
   // SIMD, unchanged) applies the mirrored pressure of the header: ρ_b = ρ0,
-  // p_b = 0, V_b = ψ_b/ρ0 and p_b V_b = 0.
-  void mirror_boundary(ParticleSet<Real>& p, std::size_t block_size) {
+  // V_b = ψ_b/ρ0, and p_b the Shepard average of the fluid's pressures around
+  // it, p_b = Σ_f p_f W_bf / Σ_f W_bf (0 with no fluid within h), so that a
+  // pair's (p_i + p_b) V_b is the fluid particle's own term doubled where the
+  // pressure is uniform, as a mirrored fluid particle would push.
+  void mirror_boundary(ParticleSet<Real>& p, std::size_t block_size, const SphLaws<Real>& laws) {
     const std::int32_t* kind = kinds(p);
     if (!kind) return;
     const Real rho0 = Real(params_.rest_density);
+    const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
     Real *rho = p.density.data(), *pr = p.pressure.data(), *V = scratch_.volume.data(), *PV = scratch_.pressure_volume.data();
-    const Real* m = p.mass.data();
+    // Two passes: the averages read fluid pressures only, then the entries are written.
+    boundary_pressure_.resize(p.size());
+    Real* pb = boundary_pressure_.data();
+    parallel::for_blocks_pinned("sph_boundary_pressure", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      const SphLaws<Real> law = laws;
+      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
+        if (!is_boundary(kind[i])) return;
+        Real weighted = 0, weights = 0;
+        detail::for_each_pair(x, y, z, i, ranges, count, law.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (is_boundary(kind[j])) return;
+          const Real w = law.density.term(Real(1), law.gap2(r2));
+          weighted += w * pr[j];
+          weights += w;
+        });
+        pb[i] = weights > Real(0) ? weighted / weights : Real(0);
+      });
+    });
     parallel::for_blocks_pinned("sph_boundary_mirror", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       for (std::size_t i = b; i < e; ++i) {
         if (!is_boundary(kind[i])) continue;
         rho[i] = rho0;
-        pr[i] = 0;
+        pr[i] = pb[i];
         V[i] = m[i] / rho0;
-        PV[i] = 0;
+        PV[i] = pb[i] * V[i];
       }
     });
   }
@@ -381,7 +408,7 @@ class SphFluid final : public Solver<Real> {
     {
       PhaseScope phase(ctx, "forces.density");
       pairs = grid_density(grid_, p, k, ctx.block_size, scratch_, kernel_path());
-      mirror_boundary(p, ctx.block_size);
+      mirror_boundary(p, ctx.block_size, k);
     }
     mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
     count_evaluation();
@@ -533,6 +560,7 @@ class SphFluid final : public Solver<Real> {
   GridScratch<Real> scratch_;
   std::optional<DfsphKernel<Real>> kernel_;  // DFSPH: built at the first evaluation
   AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
+  AlignedVector<Real> boundary_pressure_;    // thesis's solver: p_b of the last evaluation (scratch)
   double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
   static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
