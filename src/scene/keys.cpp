@@ -332,8 +332,9 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "box.walls", .section = "box", .noun = "wall kind",
                      .doc = "`\"clamp\"` (the thesis's two passes: velocities reflected, positions projected) or "
                             "`\"particles\"` (boundary particles, Akinci et al. 2012, one layer at the first "
-                            "`fluid_block`'s spacing half a spacing outside each face; needs `[sph]` with the grid "
-                            "search; the clamp stays one spacing further out as a safety net); docs/sph.md",
+                            "`fluid_block`'s spacing just outside each face, where a fluid block filling the box starts "
+                            "at the rest density; needs `[sph]` with the grid search; the clamp stays one spacing "
+                            "further out as a safety net); docs/sph.md",
                      .unhashed_value = "clamp"},
             [](auto& s) { return s.walls ? &s.wall_kind : nullptr; }));
 

@@ -181,7 +181,8 @@ inline constexpr std::array<EnumName<ObstacleSource::Shape>, 4> kObstacleShapeNa
 using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource, SnapshotSource, ObstacleSource>;
 
 // box.walls: the thesis's clamp (the box's two passes), or the box's faces
-// sampled by boundary particles half a spacing outside it (the clamp then
+// sampled by boundary particles just outside it (scene::wall_offset(): where
+// a fluid block filling the box starts at the rest density; the clamp then
 // stays, one spacing further out, as a safety net that a fluid particle meets
 // only if it leaked through).
 enum class Walls { Clamp, Particles };
