@@ -233,6 +233,33 @@ TEST(BoundaryVolumes, PsiAndTheFluidDensityMatchBruteForceSums) {
   }
 }
 
+// The diagnostics leave the boundary out where its ψ "mass" would distort them:
+// the fluid's density errors and gravity's potential energy.
+TEST(BoundaryVolumes, TheDiagnosticsAreTheFluids) {
+  Simulation<double> sim = build(tank_scene(0.15, 0.1, 0.2, 0.1, 0.1, 0.025, 0.002, "dfsph"));
+  sim.start();
+  const ParticleSet<double>& p = sim.particles();
+  double fluid_potential = 0, error_sum = 0, error_max = 0;
+  std::size_t fluid = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (is_boundary(kinds(p)[i])) continue;
+    ++fluid;
+    fluid_potential += p.mass[i] * 9.81 * p.position.z[i];
+    const double e = std::abs(p.density[i] - 1000.0) / 1000.0;
+    error_sum += e, error_max = std::max(error_max, e);
+  }
+  double potential = 0;
+  for (const auto& s : sim.solvers()) potential += s->potential_energy(p, 64);
+  EXPECT_NEAR(potential, fluid_potential, 1e-12 * fluid_potential);
+  const auto& sph = *sim.find_solver<sph::SphFluid<double>>();
+  std::vector<double> row;
+  sph.add_diagnostics(p, 64, row);
+  ASSERT_GE(row.size(), 2u);
+  EXPECT_NEAR(row[0], error_sum / double(fluid), 1e-12);
+  EXPECT_EQ(row[1], error_max);
+  EXPECT_EQ(fluid, sph.fluid_count(p));
+}
+
 // ---- A column at rest (the pressure profile: boundary_tank_long_test.cpp) -------
 
 TEST(BoundaryTank, AColumnAtRestStaysAtRestWithItsDensityWithinTheTolerance) {
