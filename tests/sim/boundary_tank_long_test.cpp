@@ -1,5 +1,5 @@
 // Boundary particles (Akinci et al. 2012): the hydrostatic pressure of a tank
-// with walls of particles, DFSPH (about 35 s on two cores: labelled long; the
+// with walls of particles, DFSPH (19–28 s on two shared cores: labelled long; the
 // fast checks are in boundary_test.cpp).
 #include <gtest/gtest.h>
 
