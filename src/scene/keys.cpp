@@ -30,6 +30,7 @@ constexpr std::span<const EnumName<Precision>> names_of(Precision) { return kPre
 constexpr std::span<const EnumName<Units>> names_of(Units) { return kUnitsNames; }
 constexpr std::span<const EnumName<SurfaceFormat>> names_of(SurfaceFormat) { return kSurfaceFormatNames; }
 constexpr std::span<const EnumName<TimeSteps>> names_of(TimeSteps) { return kTimeStepsNames; }
+constexpr std::span<const EnumName<Walls>> names_of(Walls) { return kWallsNames; }
 constexpr std::span<const EnumName<OutputFormat>> names_of(OutputFormat) { return kOutputFormatNames; }
 constexpr std::span<const EnumName<sph::PressureForm>> names_of(sph::PressureForm) { return sph::kPressureFormNames; }
 constexpr std::span<const EnumName<sph::NegativePressure>> names_of(sph::NegativePressure) {
@@ -328,6 +329,14 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "box.restitution", .section = "box", .range = kUnit,
                      .doc = "the fraction of its normal velocity a particle keeps when it hits a wall"},
             [](auto& s) { return s.walls ? &s.restitution : nullptr; }));
+  add(field(SceneKey{.key = "box.walls", .section = "box", .noun = "wall kind",
+                     .doc = "`\"clamp\"` (the thesis's two passes: velocities reflected, positions projected) or "
+                            "`\"particles\"` (boundary particles, Akinci et al. 2012, one layer at the first "
+                            "`fluid_block`'s spacing just outside each face, where a fluid block filling the box starts "
+                            "at the rest density; needs `[sph]` with the grid search; the clamp stays one spacing "
+                            "further out as a safety net); docs/sph.md",
+                     .unhashed_value = "clamp"},
+            [](auto& s) { return s.walls ? &s.wall_kind : nullptr; }));
 
   // [forces]
   add(field(SceneKey{.key = "forces.gravity", .section = "forces", .unit = "m/s²",
@@ -617,6 +626,7 @@ SourceKey region_corner(std::string_view key, Vec3d Box<double>::*corner, std::s
     using Pointer = decltype(&(std::get_if<LatticeSource>(&src)->region.*corner));  // const for a const source
     if (auto* l = std::get_if<LatticeSource>(&src)) return Pointer{&(l->region.*corner)};
     if (auto* r = std::get_if<RandomSource>(&src)) return Pointer{&(r->region.*corner)};
+    if (auto* o = std::get_if<ObstacleSource>(&src)) return Pointer{&(o->region.*corner)};
     return Pointer{nullptr};
   };
   return field(std::move(spec), locate);
@@ -826,6 +836,46 @@ std::vector<SourceKey> snapshot_keys() {
   return k;
 }
 
+// An obstacle's keys: its shape's, then the sampling spacing.
+std::vector<SourceKey> obstacle_keys(ObstacleSource::Shape shape) {
+  using Shape = ObstacleSource::Shape;
+  std::vector<SourceKey> k;
+  const auto vector = [&](std::string_view key, Vec3d ObstacleSource::*member, std::string_view doc) {
+    k.push_back(field(SourceKey{.key = key, .unit = "m", .doc = doc, .required = true}, in_source(member)));
+  };
+  const auto radius = [&](std::string_view doc) {
+    k.push_back(field(SourceKey{.key = "radius", .unit = "m", .range = kPositive, .doc = doc, .required = true},
+                      in_source(&ObstacleSource::radius)));
+  };
+  switch (shape) {
+    case Shape::Box:
+      k.push_back(region_corner("min", &Box<double>::lo, "the obstacle's low corner, inside the box"));
+      k.push_back(region_corner("max", &Box<double>::hi,
+                                "the high corner, inside the box, ≥ `min` on every axis (equal on one axis: a thin "
+                                "plate)"));
+      break;
+    case Shape::Sphere:
+      vector("center", &ObstacleSource::center, "the centre; the sphere lies inside the box");
+      radius("the radius");
+      break;
+    case Shape::Cylinder:
+      vector("start", &ObstacleSource::start, "the centre of one end disc");
+      vector("end", &ObstacleSource::end, "the centre of the other end disc (≠ `start`); the cylinder lies inside the box");
+      radius("the radius");
+      break;
+    case Shape::Plane:
+      vector("point", &ObstacleSource::point, "a point of the plane, inside the box");
+      k.push_back(field(SourceKey{.key = "normal", .doc = "its normal (any length > 0); the plane is clipped to the box"},
+                        in_source(&ObstacleSource::normal)));
+      break;
+  }
+  k.push_back(field(SourceKey{.key = "spacing", .unit = "m", .range = kPositive,
+                              .doc = "the distance between its boundary particles",
+                              .default_doc = "the first `fluid_block`'s spacing", .custom_read = true},
+                    in_source(&ObstacleSource::spacing)));
+  return k;
+}
+
 std::vector<SourceKind> declare_source_kinds() {
   std::vector<SourceKind> kinds;
   kinds.push_back({"lattice", "particles on a cubic lattice filling a region", lattice_keys(false), LatticeSource{}});
@@ -844,6 +894,17 @@ std::vector<SourceKind> declare_source_kinds() {
                    "particles read from a Gadget-format HDF5 file: a swirl `hdf5` frame, or initial conditions from "
                    "another code",
                    snapshot_keys(), SnapshotSource{}});
+  for (const auto& shape : kObstacleShapeNames) {
+    ObstacleSource prototype;
+    prototype.shape = shape.value;
+    static constexpr std::string_view docs[] = {
+        "a static box obstacle: its surface sampled by boundary particles (needs `[sph]`, grid search)",
+        "a static sphere: its surface sampled by boundary particles (needs `[sph]`, grid search)",
+        "a static closed cylinder: side and end discs sampled by boundary particles (needs `[sph]`, grid search)",
+        "a static plane clipped to the box (a wall across it), sampled by boundary particles (needs `[sph]`, grid "
+        "search)"};
+    kinds.push_back({shape.name, docs[static_cast<std::size_t>(shape.value)], obstacle_keys(shape.value), prototype});
+  }
   // Each key's docs table is its kind.
   for (auto& kind : kinds)
     for (auto& key : kind.keys) key.section = kind.name;
@@ -950,6 +1011,8 @@ const SourceKind& kind_of(const ParticleSource& source) {
   // "lattice", declared before "fluid_block".
   const auto same = [&](const SourceKind& kind) {
     if (kind.prototype.index() != source.index()) return false;
+    if (const auto* obstacle = std::get_if<ObstacleSource>(&source))
+      return std::get<ObstacleSource>(kind.prototype).shape == obstacle->shape;
     const auto* model = std::get_if<StellarSource>(&source);
     return !model || std::get<StellarSource>(kind.prototype).model == model->model;
   };

@@ -423,6 +423,7 @@ void read_random_box(const Table& top, Scene& s) {
   box.only(known_keys("box"));
   if (box.find("min") || box.find("max"))
     top.fail("box", "min and max are derived from the random box (L³ = N·(4/3)π h³ / k); remove them");
+  if (box.find("walls")) top.fail("box.walls", "a random box has the thesis's clamp walls only; remove it");
   s.walls = true;
   box.read(spec_of("box.restitution"), "restitution", s);
   s.random_box = Scene::RandomBox{};
@@ -551,6 +552,28 @@ void read_snapshot_file(const Table& t, SnapshotSource& src) {
   }
 }
 
+// Boundary particles are sampled at the fluid's spacing unless told: the
+// walls (box.walls = "particles") and every obstacle without a `spacing` take
+// the first fluid_block's.
+void resolve_boundary_spacing(const Table& top, Scene& s, double fluid) {
+  for (std::size_t i = 0; i < s.sources.size(); ++i) {
+    auto* obstacle = std::get_if<ObstacleSource>(&s.sources[i]);
+    if (!obstacle || obstacle->spacing > 0) continue;
+    if (fluid == 0)
+      top.fail(fmt::format("particles[{}].spacing", i),
+               "missing: the scene has no [[particles]] source of kind 'fluid_block' to take the boundary particles' "
+               "spacing from");
+    obstacle->spacing = fluid;
+  }
+  if (s.walls && s.wall_kind == Walls::Particles) {
+    if (!s.sph) top.fail("box.walls", "\"particles\" are boundary particles of the fluid: it needs an [sph] section");
+    if (fluid == 0)
+      top.fail("box.walls", "\"particles\" samples the walls at the fluid's spacing: it needs a [[particles]] source "
+                            "of kind 'fluid_block'");
+    s.wall_spacing = fluid;
+  }
+}
+
 void read_particles(const Table& top, Scene& s) {
   const Reader& r = top.reader();
   if (s.random_box) return;  // its one source was made by read_random_box()
@@ -558,6 +581,7 @@ void read_particles(const Table& top, Scene& s) {
   if (!node) r.fail("particles", "no particles: the scene needs at least one [[particles]] source");
   const auto& list = r.array(*node, "particles", "an array of tables ([[particles]])");
   const std::vector<std::string_view> any_key = any_source_keys(), kinds = kind_names();
+  double fluid_spacing = 0;  // the first fluid_block's
   for (std::size_t i = 0; i < list.size(); ++i) {
     const std::string where = fmt::format("particles[{}]", i);
     if (!list[i].is_table()) r.wrong_type(where, "a table", list[i]);
@@ -575,6 +599,7 @@ void read_particles(const Table& top, Scene& s) {
     if (kind.name == "fluid_block") {
       // Its mass is the one that gives the rest density.
       auto& lattice = std::get<LatticeSource>(source);
+      if (fluid_spacing == 0) fluid_spacing = lattice.spacing;
       if (!s.sph) t.fail("kind", "a 'fluid_block' needs an [sph] section (its mass comes from sph.rest_density)");
       if (s.sph->smoothing_length / lattice.spacing > 1000)
         t.fail("spacing", fmt::format("is over 1000 times smaller than sph.smoothing_length = {}", s.sph->smoothing_length));
@@ -582,8 +607,17 @@ void read_particles(const Table& top, Scene& s) {
                                                    s.sph->method == sph::SphMethod::Dfsph ? s.sph->kernel
                                                                                           : sph::SphKernel::Thesis);
     }
+    if (auto* obstacle = std::get_if<ObstacleSource>(&source)) {
+      if (!s.sph)
+        t.fail("kind", fmt::format("'{}' is sampled by boundary particles of the fluid: it needs an [sph] section",
+                                   kind.name));
+      if (const auto* given = t.find("spacing"))
+        obstacle->spacing = r.number(*given, t.key("spacing"), spec_in<ParticleSource>(kind.keys, "spacing").range);
+      obstacle->clip = s.box;
+    }
     s.sources.push_back(std::move(source));
   }
+  resolve_boundary_spacing(top, s, fluid_spacing);
 }
 
 Scene read_scene(const toml::table& root, std::string_view file) {

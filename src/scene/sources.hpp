@@ -25,6 +25,13 @@ std::array<std::uint64_t, 3> lattice_counts(const LatticeSource& source);
 // Particles one source makes, saturating at kSaturated.
 std::uint64_t source_count(const ParticleSource& source);
 
+// Boundary particles of one obstacle (obstacle_points() would make), saturating.
+std::uint64_t obstacle_count(const ObstacleSource& source);
+
+// The walls' boundary particles (box.walls = "particles"; 0 otherwise), and the box they sample.
+std::uint64_t wall_count(const Scene& scene);
+Box<double> grown_box(const Scene& scene);
+
 // x moved by `by`, adding only the non-zero components: x + 0.0 turns a −0.0
 // into +0.0, and a snapshot read back must give its particles bit for bit.
 inline Vec3d moved(Vec3d x, const Vec3d& by) {

@@ -109,6 +109,24 @@ class Checker {
                        s_.sph->smoothing_length + s_.sph->grid_skin, keys));
   }
 
+  // Boundary particles (walls or obstacles) are the fluid's: [sph] with the grid search.
+  void boundary() const {
+    const bool walls = s_.walls && s_.wall_kind == Walls::Particles;
+    if (!s_.has_boundary_particles()) return;
+    std::string where = "box.walls";
+    for (std::size_t i = 0; i < s_.sources.size() && !walls; ++i)
+      if (std::holds_alternative<ObstacleSource>(s_.sources[i])) {
+        where = fmt::format("particles[{}].kind", i);
+        break;
+      }
+    if (!s_.sph) fail(where, "boundary particles are the fluid's: they need an [sph] section");
+    if (s_.sph->neighbour_search != sph::NeighbourSearch::Grid)
+      fail("sph.neighbour_search", fmt::format("boundary particles ({}) need the grid search; use \"grid\"", where));
+    if (walls && !(s_.wall_spacing > 0))
+      fail("box.walls", fmt::format("\"particles\" needs the walls' spacing (the first fluid_block's), got {}",
+                                    s_.wall_spacing));
+  }
+
   void output() const {
     if (s_.surface == SurfaceFormat::None) return;
     if (!s_.sph)
@@ -136,6 +154,7 @@ class Checker {
       else if (const auto* r = std::get_if<RandomSource>(&source)) region(r->region, where);
       else if (const auto* list = std::get_if<ListSource>(&source)) listed(*list, where);
       else if (const auto* snapshot = std::get_if<SnapshotSource>(&source)) snapshot_file(*snapshot, where);
+      else if (const auto* obstacle = std::get_if<ObstacleSource>(&source)) obstacle_shape(*obstacle, where);
       else stellar(std::get<StellarSource>(source), where);
       const std::uint64_t n = detail::source_count(source);
       if (n > detail::kMaxParticles)
@@ -144,6 +163,7 @@ class Checker {
       total = detail::add_sat(total, n);
     }
     if (total == 0) fail("particles", "no particles: the scene needs at least one [[particles]] source");
+    total = detail::add_sat(total, detail::wall_count(s_));
     if (total > detail::kMaxParticles)
       fail("particles", fmt::format("the sources make {} particles in total, more than the limit of {} (2^31)",
                                     count_text(total), detail::kMaxParticles));
@@ -241,6 +261,62 @@ class Checker {
                           file, factors));
   }
 
+  // An obstacle's geometry: inside the box (when the scene has one), not degenerate.
+  void obstacle_shape(const ObstacleSource& o, std::string_view where) const {
+    using Shape = ObstacleSource::Shape;
+    const auto key = [&](std::string_view k) { return fmt::format("{}.{}", where, k); };
+    // The box [lo, hi] of the obstacle's points must lie in the scene's box.
+    const auto within = [&](const Vec3d& lo, const Vec3d& hi, std::string_view k, std::string_view what) {
+      if (!s_.walls) return;
+      if (!s_.box.contains(lo) || !s_.box.contains(hi))
+        fail(key(k), fmt::format("{} reaches outside the box {} (it spans {} to {})", what, detail::box_text(s_.box),
+                                 detail::vec_text(lo), detail::vec_text(hi)));
+    };
+    switch (o.shape) {
+      case Shape::Box: {
+        inside(o.region.lo, key("min"));
+        inside(o.region.hi, key("max"));
+        int flat = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+          if (o.region.hi[axis] < o.region.lo[axis])
+            fail(key("max"), fmt::format("must be ≥ {} on every axis, but along {} {} < {}", key("min"), "xyz"[axis],
+                                         o.region.hi[axis], o.region.lo[axis]));
+          flat += o.region.hi[axis] == o.region.lo[axis] ? 1 : 0;
+        }
+        if (flat > 1) fail(key("max"), "the obstacle is a line or a point: it needs an extent along two axes at least");
+        break;
+      }
+      case Shape::Sphere: {
+        inside(o.center, key("center"));
+        const Vec3d r{o.radius, o.radius, o.radius};
+        within(o.center - r, o.center + r, "radius", fmt::format("the sphere of radius {}", o.radius));
+        break;
+      }
+      case Shape::Cylinder: {
+        inside(o.start, key("start"));
+        inside(o.end, key("end"));
+        const Vec3d axis = o.end - o.start;
+        const double length = norm(axis);
+        if (!(length > 0)) fail(key("end"), fmt::format("equals {}: the cylinder has no length", key("start")));
+        Vec3d lo, hi;
+        for (int a = 0; a < 3; ++a) {  // the end discs' extent along each axis
+          const double e = axis[a] / length, reach = o.radius * std::sqrt(std::max(0.0, 1 - e * e));
+          lo[a] = std::min(o.start[a], o.end[a]) - reach;
+          hi[a] = std::max(o.start[a], o.end[a]) + reach;
+        }
+        within(lo, hi, "radius", fmt::format("the cylinder of radius {}", o.radius));
+        break;
+      }
+      case Shape::Plane:
+        if (!s_.walls) fail(key("kind"), "'obstacle_plane' is clipped to the box: it needs a [box]");
+        inside(o.point, key("point"));
+        if (!(norm(o.normal) > 0)) fail(key("normal"), "must not be zero");
+        break;
+    }
+    if (detail::obstacle_count(o) == 0)
+      fail(where, fmt::format("makes no boundary particles at spacing {}", o.spacing));
+  }
+
   void stellar(const StellarSource& m, std::string_view where) const {
     const std::string_view kind = enum_name<StellarSource::Model>(kStellarModelNames, m.model);
     if (s_.walls)
@@ -284,6 +360,7 @@ void validate(const Scene& scene) {
   check.sph();
   check.output();
   check.sources();
+  check.boundary();
 }
 
 double dense_cell_table_keys(const Scene& scene) {

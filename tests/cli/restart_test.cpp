@@ -46,6 +46,26 @@ TEST_F(Restart, SphWithASkinResumesBitIdentically) {
   expect_same_outputs(dir_ / "a", dir_ / "b");
 }
 
+// Boundary particles (walls and an obstacle of particles, DFSPH, adaptive
+// steps): their kind and volume weights travel in the checkpoint, and the
+// solver's "volumes done" flag in its state.
+TEST_F(Restart, BoundaryParticlesResumeBitIdentically) {
+  const std::string obstacle =
+      kExamples + "dam_break_obstacle.toml --set particles.0.spacing=0.08 --set output.interval=0.01";
+  ASSERT_EQ(swirl("run " + obstacle + " --steps 30 --threads 2 --out " + (dir_ / "a").string()).status, 0);
+  ASSERT_EQ(swirl("run " + obstacle + " --steps 12 --threads 1 --checkpoint-every-steps 6 --out " + (dir_ / "b").string()).status, 0);
+  const auto r = swirl("run --resume " + (dir_ / "b").string() + " --steps 18 --threads 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_same_outputs(dir_ / "a", dir_ / "b");
+  // The frames hold the kind field, and the boundary particles are in them.
+  const auto frame = swirl::io::read_vtp(dir_ / "a" / "particles_000000.vtp");
+  ASSERT_TRUE(frame.point_data.count("kind"));
+  EXPECT_EQ(frame.point_data.at("kind").type, "Int32");
+  std::size_t boundary = 0;
+  for (const auto k : frame.point_data.at("kind").template values<std::int32_t>()) boundary += k == 1 ? 1 : 0;
+  EXPECT_GT(boundary, 1000u);
+}
+
 // SPH and self-gravity in one run (one order for both, adaptive steps).
 TEST_F(Restart, BothSolversResumeBitIdentically) {
   const std::string drop = std::string(SWIRL_SOURCE_DIR) +

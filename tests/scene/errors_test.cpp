@@ -156,7 +156,7 @@ TEST(SceneErrors, ConflictsAndLengths) {
 TEST(SceneErrors, UnknownNamesListTheAllowedOnes) {
   for (const Case& c : std::vector<Case>{
            {"kind", full("kind = \"random\"", "kind = \"grid\""),
-            "particles[1].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list', 'fluid_block', 'plummer', 'uniform_sphere', 'uniform_cube', 'cold_collapse', 'plummer_collision', 'hernquist', 'nfw', 'king', 'disk_galaxy', 'snapshot')"},
+            "particles[1].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list', 'fluid_block', 'plummer', 'uniform_sphere', 'uniform_cube', 'cold_collapse', 'plummer_collision', 'hernquist', 'nfw', 'king', 'disk_galaxy', 'snapshot', 'obstacle_box', 'obstacle_sphere', 'obstacle_cylinder', 'obstacle_plane')"},
            {"precision", full("precision = \"double\"", "precision = \"single\""),
             "simulation.precision: unknown precision 'single' (allowed: 'float', 'double')"},
            {"format", full("format = [\"csv\", \"vtp\"]", "format = \"xml\""),
@@ -186,7 +186,7 @@ TEST(SceneErrors, UnknownKeysSuggestTheClosestKnownKey) {
            {"top-level key", "dt = 0.1\n" + kMinimalScene, "dt: unknown section"},
            {"key of another kind", full("spacing = 0.1", "spacing = 0.1\ncount = 3"),
             "particles[0].count: unknown key for kind 'lattice'"},
-           {"subtable", kMinimalScene + "[box.walls]\nleft = 1\n", "box.walls: unknown key"},
+           {"subtable", kMinimalScene + "[box.sides]\nleft = 1\n", "box.sides: unknown key"},
            {"first in the file", full("restitution = 0.25", "restitution = 0.25\nzeta = 1\nalpha = 2"), "box.zeta: unknown key"},
        }) {
     expect_error(c);

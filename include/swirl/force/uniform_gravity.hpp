@@ -1,11 +1,15 @@
 // UniformGravity: a constant external acceleration g on every particle, the
 // f_external/ρ term of the thesis's eq. 2.7 for a uniform field (m/s² in SI).
-// Its potential energy is U = −Σ m_i g·x_i (zero at the origin).
+// Its potential energy is U = −Σ m_i g·x_i (zero at the origin), over the
+// particles that can move: static boundary particles (core/particle_kind.hpp),
+// whose "mass" is a volume weight, are left out.
 #pragma once
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/core/vec3.hpp"
 #include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
@@ -37,12 +41,15 @@ class UniformGravity final : public Solver<Real> {
   // Summed in double per block and folded in block order: the same bits for any thread count.
   double potential_energy(const ParticleSet<Real>& p, std::size_t block_size) const override {
     const Vec3d g = g_.template cast<double>();
+    const std::size_t k = p.find_int_field(kKindField);
+    const std::int32_t* kind = k == ParticleSet<Real>::npos ? nullptr : p.int_field(k).data();
     return parallel::reduce_blocks(
         "uniform_gravity_energy", p.size(), block_size, 0.0,
         [&](std::size_t b, std::size_t e) {
           double u = 0;
           for (std::size_t i = b; i < e; ++i)
-            u -= double(p.mass[i]) * (g.x * double(p.position.x[i]) + g.y * double(p.position.y[i]) +
+            if (!kind || !is_boundary(kind[i]))
+              u -= double(p.mass[i]) * (g.x * double(p.position.x[i]) + g.y * double(p.position.y[i]) +
                                       g.z * double(p.position.z[i]));
           return u;
         },

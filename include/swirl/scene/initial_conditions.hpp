@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "swirl/core/particle_set.hpp"
 #include "swirl/scene/scene.hpp"
@@ -14,8 +15,29 @@ std::size_t count_particles(const Scene& scene);
 // Makes the particles of every source, in source order, with ids 0..N-1 in that
 // order, positions, velocities and masses set and every other field zero.
 // Deterministic: the same scene gives the same particles on any machine.
+// A scene with boundary particles (Scene::has_boundary_particles()) also
+// gets the integer field "kind" (core/particle_kind.hpp): 0 for fluid, 1 for
+// the obstacles' particles and then, after every source, the walls'
+// (box.walls = "particles"). A boundary particle starts at rest with the mass
+// ρ0·spacing³ (a placeholder: the SPH solver replaces it by its volume weight ψ).
 template <class Real>
 ParticleSet<Real> make_particles(const Scene& scene);
+
+// The boundary particles' positions of one obstacle (the sampling rules at
+// ObstacleSource), in a fixed order.
+std::vector<Vec3d> obstacle_points(const ObstacleSource& obstacle);
+
+// How far outside the box's faces the walls' boundary particles lie
+// (box.walls = "particles"; 0 otherwise): d − s/2, d from
+// sph::wall_distance_for_density() for the scene's kernel, h and the walls'
+// spacing s, so that a fluid_block's first layer (s/2 inside the box) starts
+// at the rest density (0.59 s for the cubic spline at h = 1.95 s).
+double wall_offset(const Scene& scene);
+
+// The walls' boundary particles (box.walls = "particles"): the surface of the
+// box grown by wall_offset() on every side, sampled as an obstacle_box at
+// scene.wall_spacing; empty for other scenes.
+std::vector<Vec3d> wall_points(const Scene& scene);
 
 extern template ParticleSet<float> make_particles<float>(const Scene&);
 extern template ParticleSet<double> make_particles<double>(const Scene&);

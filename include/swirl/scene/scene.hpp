@@ -146,7 +146,47 @@ struct SnapshotSource {
   std::shared_ptr<const SnapshotContent> content;
 };
 
-using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource, SnapshotSource>;
+// A static obstacle, sampled by one layer of boundary particles (Akinci et
+// al. 2012; core/particle_kind.hpp) at `spacing` (default: the first
+// fluid_block's): the surface of a box (a box of zero extent along one axis
+// is a thin plate), of a sphere, of a closed cylinder (side and end discs), or
+// a plane clipped to the scene's box. Needs [sph] with the grid search.
+// Sampling (scene/initial_conditions.hpp, obstacle_points()): a box's surface
+// is the lattice points of [min, max] with n_a = round(extent_a / spacing)
+// intervals per axis that lie on a face; a sphere's is a Fibonacci lattice of
+// round(4πr²/spacing²) points; a cylinder's is round(L/spacing) + 1 rings of
+// round(2πr/spacing) points along the axis and concentric rings on the end
+// discs; a plane's is a square lattice through `point` inside the box.
+struct ObstacleSource {
+  enum class Shape { Box, Sphere, Cylinder, Plane };
+  Shape shape = Shape::Box;
+  Box<double> region;       // box: min, max (m)
+  Vec3d center{};           // sphere: its centre (m)
+  double radius = 0;        // sphere, cylinder (m, > 0)
+  Vec3d start{}, end{};     // cylinder: the centres of its end discs (m)
+  Vec3d point{};            // plane: a point on it (m)
+  Vec3d normal{0, 0, 1};    // plane: its normal (any length > 0)
+  double spacing = 0;       // m, > 0 once loaded (load_scene: the first fluid_block's when not given)
+  Box<double> clip;         // plane: the box it is clipped to (load_scene: the scene's box)
+};
+
+// The obstacle shapes' names, which are also their [[particles]] kinds.
+inline constexpr std::array<EnumName<ObstacleSource::Shape>, 4> kObstacleShapeNames{{
+    {"obstacle_box", ObstacleSource::Shape::Box},
+    {"obstacle_sphere", ObstacleSource::Shape::Sphere},
+    {"obstacle_cylinder", ObstacleSource::Shape::Cylinder},
+    {"obstacle_plane", ObstacleSource::Shape::Plane},
+}};
+
+using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource, SnapshotSource, ObstacleSource>;
+
+// box.walls: the thesis's clamp (the box's two passes), or the box's faces
+// sampled by boundary particles just outside it (scene::wall_offset(): where
+// a fluid block filling the box starts at the rest density; the clamp then
+// stays, one spacing further out, as a safety net that a fluid particle meets
+// only if it leaked through).
+enum class Walls { Clamp, Particles };
+inline constexpr std::array<EnumName<Walls>, 2> kWallsNames{{{"clamp", Walls::Clamp}, {"particles", Walls::Particles}}};
 
 struct Scene {
   std::string file;                        // where it came from, for messages
@@ -183,6 +223,9 @@ struct Scene {
   bool walls = true;                       // a [box] section: walls; without one, open space
   Box<double> box;                         // box.min, box.max, m (used only with walls)
   double restitution = 0.5;                // box.restitution, e in [0, 1]
+  Walls wall_kind = Walls::Clamp;          // box.walls
+  double wall_spacing = 0;                 // m: the boundary particles' spacing on the walls (with
+                                           // box.walls = "particles": the first fluid_block's spacing)
 
   Vec3d gravity{0, 0, -9.81};              // forces.gravity, m/s², uniform
   double damping = 0;                      // forces.damping, 1/s, ≥ 0: a drag a = −damping·v (settling runs)
@@ -221,6 +264,14 @@ struct Scene {
   // that would overshoot end_time by less than 1e-9·dt is not added). With
   // adaptive steps and an end_time, the fewest steps (all of dt_max).
   std::uint64_t total_steps() const;
+
+  // True when the scene has boundary particles (box.walls = "particles" or an obstacle source).
+  bool has_boundary_particles() const {
+    if (walls && wall_kind == Walls::Particles) return true;
+    for (const auto& s : sources)
+      if (std::holds_alternative<ObstacleSource>(s)) return true;
+    return false;
+  }
 };
 
 // A scene file that cannot be used. what() names the file, the key (or line

@@ -34,7 +34,17 @@ Simulation<Real> build_simulation(const scene::Scene& scene) {
   // A particle further outside than the kernel support has left the box (the guard).
   if (scene.walls && scene.sph) settings.escape_length = scene.sph->smoothing_length;
   std::optional<boundary::BoxCollision<Real>> box;
-  if (scene.walls) box = boundary::BoxCollision<Real>{scene.box.template cast<Real>(), Real(scene.restitution)};
+  if (scene.walls) {
+    // With box.walls = "particles" the walls are boundary particles just
+    // outside the box (scene::wall_offset()); the clamp stays one spacing
+    // further out, a safety net that only a particle which leaked through meets.
+    Box<double> clamp = scene.box;
+    if (scene.wall_kind == scene::Walls::Particles) {
+      const double reach = scene::wall_offset(scene) + scene.wall_spacing;
+      clamp = {scene.box.lo - Vec3d{reach, reach, reach}, scene.box.hi + Vec3d{reach, reach, reach}};
+    }
+    box = boundary::BoxCollision<Real>{clamp.template cast<Real>(), Real(scene.restitution)};
+  }
   std::unique_ptr<integrate::Stepper<Real>> stepper;
   std::unique_ptr<sph::SphFluid<Real>> fluid;
   if (scene.sph)

@@ -55,6 +55,7 @@
 #include <fmt/format.h>
 
 #include "swirl/boundary/box_collision.hpp"
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/phase_timers.hpp"
@@ -318,6 +319,24 @@ class Simulation {
       ctx.active = ActiveSet{particles_.int_field(bins).data(), min_bin};
     }
     for (auto& s : solvers_) s->add_acceleration(particles_, ctx);
+    hold_boundary_particles();
+  }
+
+  // Boundary particles (core/particle_kind.hpp) are static: their
+  // acceleration is zeroed after every evaluation (gravity and the fluid's
+  // reaction included), so that with v = 0 the steppers leave them in place.
+  void hold_boundary_particles() {
+    const std::size_t k = particles_.find_int_field(kKindField);
+    if (k == ParticleSet<Real>::npos) return;
+    const std::int32_t* kind = particles_.int_field(k).data();
+    parallel::for_blocks_pinned("hold_boundary", particles_.size(), settings_.block_size,
+                                [&](std::size_t b, std::size_t e, std::size_t) {
+                                  for (int axis = 0; axis < 3; ++axis) {
+                                    Real* a = particles_.acceleration[axis].data();
+#pragma omp simd
+                                    for (std::size_t i = b; i < e; ++i) a[i] = is_boundary(kind[i]) ? Real(0) : a[i];
+                                  }
+                                });
   }
 
   // The first particle whose position is not finite (the order found one).

@@ -22,6 +22,16 @@
 //                              the thesis's viscosity term (eq. 2.10) as the
 //                              non-pressure force
 //
+// Boundary particles (Akinci et al. 2012; core/particle_kind.hpp): with a
+// `kind` array (null: all fluid), a boundary particle b carries its volume
+// weight ψ_b = ρ0 / Σ_k W_bk in its mass, so the sums over j above take it as
+// one more neighbour of mass ψ_b at rest (v_b = 0); its own κ stays 0, so the
+// pressure term of a pair (i, b) is ψ_b (κ_i/ρ_i) ∇W_ib, the fluid particle's
+// own term (the pressure mirrored onto the wall). In α's second sum only
+// fluid neighbours count (a boundary particle has no κ of its own to solve
+// for). A boundary particle itself is skipped: ρ_b = ρ0, α_b = 0, Dρ/Dt = 0,
+// its velocity and acceleration untouched.
+//
 // Scalar loops, one pair at a time (correctness first: the SIMD twins of the
 // thesis's passes, sph/grid_passes.hpp, are the model for faster ones).
 // Each pass writes only particle i's entries and gathers over the grid's fixed
@@ -34,6 +44,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/cell_grid.hpp"
@@ -79,11 +90,12 @@ double dfsph_lattice_factor(const DfsphKernel<Real>& kernel, double m, double s)
 }
 
 // ρ into p.density, α into alpha[0, n), α at most alpha_cap; returns the
-// neighbour pairs (self excluded).
+// neighbour pairs (self excluded). kind: null, or the particles' kinds (then
+// a boundary particle gets ρ = rest_density and α = 0).
 template <class Real>
 std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
                                        const DfsphKernel<Real>& kernel, std::size_t block_size, Real* alpha,
-                                       Real alpha_cap) {
+                                       Real alpha_cap, const std::int32_t* kind = nullptr, Real rest_density = 0) {
   const std::size_t n = p.size();
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real* rho = p.density.data();
@@ -93,6 +105,11 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
         const DfsphKernel<Real> k = kernel;
         std::uint64_t pairs = 0;
         detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+          if (kind && is_boundary(kind[i])) {
+            rho[i] = rest_density;
+            alpha[i] = 0;
+            return;
+          }
           Real density = 0, gx = 0, gy = 0, gz = 0, g2 = 0;
           std::uint64_t found = 0;
           detail::for_each_pair(x, y, z, i, ranges, count, k.h2, [&](std::size_t j, Real dx, Real dy, Real dz, Real r2) {
@@ -101,7 +118,7 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
             ++found;
             const Real g = m[j] * k.gradient(r);  // m_j ∇W_ij = g · r⃗_ij (0 for j = i)
             gx += g * dx, gy += g * dy, gz += g * dz;
-            g2 += g * g * r2;
+            if (!kind || !is_boundary(kind[j])) g2 += g * g * r2;
           });
           rho[i] = density;
           const Real denominator = gx * gx + gy * gy + gz * gz + g2;
@@ -117,15 +134,20 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
       [](std::uint64_t a, std::uint64_t b) { return a + b; });
 }
 
-// out[i] = (Dρ/Dt)_i from the current velocities.
+// out[i] = (Dρ/Dt)_i from the current velocities (0 for a boundary particle).
 template <class Real>
 void dfsph_density_change(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& p,
-                          const DfsphKernel<Real>& kernel, std::size_t block_size, Real* out) {
+                          const DfsphKernel<Real>& kernel, std::size_t block_size, Real* out,
+                          const std::int32_t* kind = nullptr) {
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
   parallel::for_blocks_pinned("dfsph_density_change", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     const DfsphKernel<Real> k = kernel;
     detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+      if (kind && is_boundary(kind[i])) {
+        out[i] = 0;
+        return;
+      }
       Real sum = 0;
       detail::for_each_pair(x, y, z, i, ranges, count, k.h2, [&](std::size_t j, Real dx, Real dy, Real dz, Real r2) {
         const Real g = m[j] * k.gradient(std::sqrt(r2));
@@ -136,16 +158,19 @@ void dfsph_density_change(const spatial::SortedCellGrid<Real>& grid, const Parti
   });
 }
 
-// v_i −= Δt Σ_j m_j (k_i + k_j) ∇W_ij, k = κ/ρ per particle. Reads no velocity,
-// so writing v_i in place is safe.
+// v_i −= Δt Σ_j m_j (k_i + k_j) ∇W_ij, k = κ/ρ per particle (0 for a boundary
+// particle, whose velocity is left alone). Reads no velocity, so writing v_i
+// in place is safe.
 template <class Real>
 void dfsph_pressure_velocity(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
-                             const DfsphKernel<Real>& kernel, std::size_t block_size, const Real* k_over_rho, Real dt) {
+                             const DfsphKernel<Real>& kernel, std::size_t block_size, const Real* k_over_rho, Real dt,
+                             const std::int32_t* kind = nullptr) {
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
   parallel::for_blocks_pinned("dfsph_pressure", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     const DfsphKernel<Real> k = kernel;
     detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+      if (kind && is_boundary(kind[i])) return;
       Real ax = 0, ay = 0, az = 0;
       const Real ki = k_over_rho[i];
       detail::for_each_pair(x, y, z, i, ranges, count, k.h2, [&](std::size_t j, Real dx, Real dy, Real dz, Real r2) {
@@ -162,13 +187,14 @@ void dfsph_pressure_velocity(const spatial::SortedCellGrid<Real>& grid, Particle
 // a_i += the thesis's viscous acceleration (eq. 2.10 / ρ_i, laws.viscosity).
 template <class Real>
 void dfsph_add_viscosity(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
-                         std::size_t block_size) {
+                         std::size_t block_size, const std::int32_t* kind = nullptr) {
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data(), *rho = p.density.data();
   Real *ax = p.acceleration.x.data(), *ay = p.acceleration.y.data(), *az = p.acceleration.z.data();
   parallel::for_blocks_pinned("dfsph_viscosity", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     const SphLaws<Real> law = laws;
     detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+      if (kind && is_boundary(kind[i])) return;  // static: its acceleration is zeroed anyway
       Real sx = 0, sy = 0, sz = 0;
       detail::for_each_pair(x, y, z, i, ranges, count, law.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
         const Real t = law.viscosity.term(m[j] / rho[j], law.gap(std::sqrt(r2)));

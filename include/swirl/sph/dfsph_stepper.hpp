@@ -48,6 +48,10 @@
 // A solve that reaches sph.dfsph.max_iterations above its tolerance is reported
 // to the guard (BlowUpCause::NotConverged: "solver did not converge").
 //
+// Boundary particles (core/particle_kind.hpp, sph/sph_fluid.hpp) are in every
+// pass as neighbours and skipped as particles: κ_b stays 0, v_b stays 0, and
+// a = 0 (the simulation zeroes it), so the kick and the drift leave them put.
+//
 // Resume: the warm starts are particle fields; the grid and α are not, so the
 // first step after a resume re-evaluates the forces at the restored x (the
 // same bits: the same positions in the same order) before step 1.
@@ -246,7 +250,9 @@ class DfsphStepper final : public integrate::Stepper<Real> {
     });
     pressure_velocity(p, kr, dt, bs);
     DfsphSolve s;
-    const double scale = n ? 1.0 / (double(n) * double(rho0)) : 0.0;
+    // The average over the fluid: boundary particles (static, ρ = ρ0, Dρ/Dt = 0) add no error.
+    const std::size_t fluid = fluid_.fluid_count(p);
+    const double scale = fluid ? 1.0 / (double(fluid) * double(rho0)) : 0.0;
     for (;;) {
       fluid_.density_change(p, d, bs);
       // Σ_i of the compression (ρ* − ρ0, or Dρ/Dt·Δt), positive parts only, in block order.

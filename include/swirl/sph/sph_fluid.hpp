@@ -61,6 +61,35 @@
 // kKappaVField), so reorders and checkpoints carry them. Its time-step
 // condition is a CFL without a sound speed: Δt ≤ C·h/|v|max (sph.dfsph.cfl).
 //
+// Boundary particles (Akinci et al. 2012, "Versatile rigid-fluid coupling for
+// incompressible SPH"; core/particle_kind.hpp): when the particle set has the
+// integer field "kind", its boundary particles (kind 1, static, one layer at
+// the fluid's spacing) enter the fluid's sums with the volume weight
+//   ψ_b = ρ0 / Σ_k W_bk      (k: the boundary particles within h of b, b included)
+// in place of a mass, computed with the density kernel at the first
+// evaluation and stored in the boundary particle's mass field (static
+// boundaries: once; the flag travels in the solver's state, so a resume does
+// not recompute it). Then for a fluid particle i
+//   ρ_i += Σ_b ψ_b W_ib
+// and the pressure force is mirrored onto the wall. For DFSPH (sph/
+// dfsph_passes.hpp) as Akinci and SPlisHSPlasH do it: the pair (i, b) adds the
+// fluid particle's own term ψ_b (κ_i/ρ_i) ∇W_ib (κ/ρ = p/ρ²), to ρ, α and the
+// pressure passes alike. For the thesis's solver, whose pair law is
+// (p_i V_j + p_j V_j) with V = m/ρ, the boundary particle gets V_b = ψ_b/ρ0 and
+// the pressure p_b = Σ_f p_f W_bf / Σ_f W_bf, the Shepard average of the fluid
+// pressures around it (Adami et al. 2012's wall pressure without its
+// hydrostatic term): where the pressure is uniform the pair pushes with
+// 2 p_i V_b, as a fluid particle mirrored across the wall would. (The fluid's
+// own term alone, p_i V_b, let a particle of the dam break through a thin
+// plate at t = 0.38 s: the normal push of a sheet vanishes in its plane, and
+// the weakly compressible fluid behind squeezed it there.) These are per-
+// particle entries written between the density and the force pass, so the
+// SIMD force pass and its scalar twin run unchanged. The viscosity treats a
+// boundary particle as a neighbour at rest of volume ψ_b/ρ0 (no-slip walls).
+// A boundary particle's own density is reported as ρ0 and its pressure as 0
+// (DFSPH) or p_b (the thesis's); the fluid's diagnostics and the DFSPH errors
+// count fluid particles only. Boundary particles need the grid search.
+//
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
 // Every pass gathers into particle i only: deterministic for any thread count.
 #pragma once
@@ -78,6 +107,7 @@
 
 #include <fmt/format.h>
 
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/core/phase_timers.hpp"
 #include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
@@ -195,15 +225,25 @@ class SphFluid final : public Solver<Real> {
   // α_i of the last evaluation (sorted order), for every particle.
   const Real* factor() const { return alpha_.data(); }
   void density_change(const ParticleSet<Real>& p, Real* out, std::size_t block_size) const {
-    dfsph_density_change(grid_, p, *kernel_, block_size, out);
+    dfsph_density_change(grid_, p, *kernel_, block_size, out, kinds(p));
   }
   void pressure_velocity(ParticleSet<Real>& p, const Real* k_over_rho, Real dt, std::size_t block_size) const {
-    dfsph_pressure_velocity(grid_, p, *kernel_, block_size, k_over_rho, dt);
+    dfsph_pressure_velocity(grid_, p, *kernel_, block_size, k_over_rho, dt, kinds(p));
   }
   // The non-pressure force of the fluid: the thesis's viscosity (eq. 2.10).
   void add_viscosity(ParticleSet<Real>& p, std::size_t block_size) const {
-    if (params_.viscosity > 0) dfsph_add_viscosity(grid_, p, SphLaws<Real>(params_), block_size);
+    if (params_.viscosity > 0) dfsph_add_viscosity(grid_, p, SphLaws<Real>(params_), block_size, kinds(p));
   }
+
+  // The particles' kinds (core/particle_kind.hpp), or null when all are fluid.
+  static const std::int32_t* kinds(const ParticleSet<Real>& p) {
+    const std::size_t k = p.find_int_field(kKindField);
+    return k == ParticleSet<Real>::npos ? nullptr : p.int_field(k).data();
+  }
+  // Fluid particles (not boundary) as of the last evaluation: what averages over the fluid divide by.
+  std::size_t fluid_count(const ParticleSet<Real>& p) const { return kinds(p) ? fluid_count_ : p.size(); }
+  // Boundary particles in the set (0 without the kind field).
+  std::size_t boundary_count(const ParticleSet<Real>& p) const { return kinds(p) ? p.size() - fluid_count_ : 0; }
 
   std::vector<std::string> diagnostic_columns() const override {
     return {"mean_density_error", "max_density_error", "mean_neighbours"};
@@ -213,11 +253,14 @@ class SphFluid final : public Solver<Real> {
   void add_diagnostics(const ParticleSet<Real>& p, std::size_t block_size, std::vector<double>& row) const override {
     using Partial = std::array<double, 2>;
     const double rho0 = params_.rest_density;
+    const std::int32_t* kind = kinds(p);
+    const std::size_t fluid = kind ? count_fluid(p) : p.size();
     const Partial e = parallel::reduce_blocks(
         "sph_diagnostics", p.size(), block_size, Partial{},
         [&](std::size_t b, std::size_t end) {
           Partial s{};
           for (std::size_t i = b; i < end; ++i) {
+            if (kind && is_boundary(kind[i])) continue;  // the fluid's error only
             const double error = std::abs(double(p.density[i]) - rho0) / rho0;
             s[0] += error;
             s[1] = std::max(s[1], error);
@@ -225,7 +268,7 @@ class SphFluid final : public Solver<Real> {
           return s;
         },
         [](Partial a, const Partial& b) { return Partial{a[0] + b[0], std::max(a[1], b[1])}; });
-    row.insert(row.end(), {p.empty() ? 0.0 : e[0] / double(p.size()), e[1], mean_neighbours_});
+    row.insert(row.end(), {fluid == 0 ? 0.0 : e[0] / double(fluid), e[1], mean_neighbours_});
   }
   // Viscosity dissipates, and the equation of state's elastic energy is not counted.
   bool conserves_energy() const override { return false; }
@@ -235,10 +278,12 @@ class SphFluid final : public Solver<Real> {
   void save_state(NamedValues& out) const override {
     out.emplace_back("sph.neighbour_sum", neighbour_sum_);
     out.emplace_back("sph.evaluations", double(evaluations_));
+    if (boundary_volumes_) out.emplace_back("sph.boundary_volumes", 1.0);
   }
   void load_state(const NamedValues& values) override {
     neighbour_sum_ = find_value(values, "sph.neighbour_sum").value_or(0.0);
     evaluations_ = static_cast<std::uint64_t>(find_value(values, "sph.evaluations").value_or(0.0));
+    boundary_volumes_ = find_value(values, "sph.boundary_volumes").value_or(0.0) != 0;
   }
 
   // Interaction lists of the last evaluation (one row per particle; hash search
@@ -269,6 +314,81 @@ class SphFluid final : public Solver<Real> {
     ++evaluations_;
   }
 
+  static std::size_t count_fluid(const ParticleSet<Real>& p) {
+    const std::int32_t* kind = kinds(p);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) n += kind && is_boundary(kind[i]) ? 0 : 1;
+    return n;
+  }
+
+  // Boundary particles, once the grid view is up: the fluid count, and (once
+  // for static boundaries) every boundary particle's ψ_b = ρ0 / Σ_k W_bk over
+  // the boundary particles k within h (b included), W the density kernel
+  // `w(r², r)`, stored as its mass. Gathers into b only, in the grid's order:
+  // the same bits for any thread count, and on a resume (the flag is state).
+  template <class W>
+  void prepare_boundary(ParticleSet<Real>& p, std::size_t block_size, W&& w) {
+    const std::int32_t* kind = kinds(p);
+    if (!kind) return;
+    if (!counted_) fluid_count_ = count_fluid(p), counted_ = true;
+    if (boundary_volumes_) return;
+    const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
+    Real* m = p.mass.data();
+    const Real h2 = Real(params_.smoothing_length * params_.smoothing_length), rho0 = Real(params_.rest_density);
+    parallel::for_blocks_pinned("sph_boundary_volume", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
+        if (!is_boundary(kind[i])) return;
+        Real sum = 0;
+        detail::for_each_pair(x, y, z, i, ranges, count, h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (is_boundary(kind[j])) sum += w(r2, std::sqrt(r2));
+        });
+        m[i] = rho0 / sum;  // sum ≥ W(0) > 0: b itself
+      });
+    });
+    boundary_volumes_ = true;
+  }
+
+  // The thesis's passes with boundary particles: after the density pass, a
+  // boundary particle's entries are set so that the force pass (scalar or
+  // SIMD, unchanged) applies the mirrored pressure of the header: ρ_b = ρ0,
+  // V_b = ψ_b/ρ0, and p_b the Shepard average of the fluid's pressures around
+  // it, p_b = Σ_f p_f W_bf / Σ_f W_bf (0 with no fluid within h), so that a
+  // pair's (p_i + p_b) V_b is the fluid particle's own term doubled where the
+  // pressure is uniform, as a mirrored fluid particle would push.
+  void mirror_boundary(ParticleSet<Real>& p, std::size_t block_size, const SphLaws<Real>& laws) {
+    const std::int32_t* kind = kinds(p);
+    if (!kind) return;
+    const Real rho0 = Real(params_.rest_density);
+    const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
+    Real *rho = p.density.data(), *pr = p.pressure.data(), *V = scratch_.volume.data(), *PV = scratch_.pressure_volume.data();
+    // Two passes: the averages read fluid pressures only, then the entries are written.
+    boundary_pressure_.resize(p.size());
+    Real* pb = boundary_pressure_.data();
+    parallel::for_blocks_pinned("sph_boundary_pressure", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      const SphLaws<Real> law = laws;
+      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
+        if (!is_boundary(kind[i])) return;
+        Real weighted = 0, weights = 0;
+        detail::for_each_pair(x, y, z, i, ranges, count, law.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (is_boundary(kind[j])) return;
+          const Real w = law.density.term(Real(1), law.gap2(r2));
+          weighted += w * pr[j];
+          weights += w;
+        });
+        pb[i] = weights > Real(0) ? weighted / weights : Real(0);
+      });
+    });
+    parallel::for_blocks_pinned("sph_boundary_mirror", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t i = b; i < e; ++i) {
+        if (!is_boundary(kind[i])) continue;
+        rho[i] = rho0;
+        pr[i] = pb[i];
+        V[i] = m[i] / rho0;
+        PV[i] = pb[i] * V[i];
+      }
+    });
+  }
+
   // The sorted grid (spatial/cell_grid.hpp, sph/grid_passes.hpp): a view of
   // the simulation's order, then density and forces on the fly. Returns
   // false, having done nothing, when the particles spread too far for the grid.
@@ -283,10 +403,12 @@ class SphFluid final : public Solver<Real> {
     used_grid_ = true;
     lists_ = {};
     const SphLaws<Real> k(params_);
+    prepare_boundary(p, ctx.block_size, [&](Real r2, Real) { return k.density.density(k.density.term(Real(1), k.gap2(r2))); });
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.density");
       pairs = grid_density(grid_, p, k, ctx.block_size, scratch_, kernel_path());
+      mirror_boundary(p, ctx.block_size, k);
     }
     mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
     count_evaluation();
@@ -316,12 +438,16 @@ class SphFluid final : public Solver<Real> {
     used_grid_ = true;
     lists_ = {};
     if (!kernel_) kernel_.emplace(params_.kernel, Real(params_.smoothing_length));
+    prepare_boundary(p, ctx.block_size, [&](Real r2, Real r) { return kernel_->w(r2, r); });
+    const std::int32_t* kind = kinds(p);
     if (!(alpha_cap_ > 0) && !p.empty()) {
       // The cap of α: twice the factor of a full lattice neighbourhood at the
-      // spacing s = (m/ρ0)^⅓ of the largest mass (scenes' fluids have one
-      // mass; the largest, unlike the first, does not depend on the order).
+      // spacing s = (m/ρ0)^⅓ of the largest fluid mass (scenes' fluids have one
+      // mass; the largest, unlike the first, does not depend on the order;
+      // a boundary particle's mass is its ψ).
       double m = 0;
-      for (std::size_t i = 0; i < p.size(); ++i) m = std::max(m, double(p.mass[i]));
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (!kind || !is_boundary(kind[i])) m = std::max(m, double(p.mass[i]));
       const double s = std::cbrt(m / params_.rest_density);
       alpha_cap_ = kAlphaCapFactor * dfsph_lattice_factor(*kernel_, m, s);
     }
@@ -329,14 +455,20 @@ class SphFluid final : public Solver<Real> {
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.density");
-      pairs = dfsph_density_and_factor(grid_, p, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_));
+      pairs = dfsph_density_and_factor(grid_, p, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_), kind,
+                                       Real(params_.rest_density));
     }
-    mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
+    const std::size_t fluid = fluid_count(p);  // a boundary particle's own pairs are not summed
+    mean_neighbours_ = fluid == 0 ? 0.0 : static_cast<double>(pairs) / static_cast<double>(fluid);
     count_evaluation();
   }
 
   // The thesis's path: spatial hash, lists with density inside the search.
   void add_acceleration_hash(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
+    if (kinds(p))
+      throw std::runtime_error(
+          "SPH: boundary particles need the grid search (sph.neighbour_search = \"grid\"; the hash path has none, and "
+          "the grid fell back to it if the particles spread over more than 2^21 cells along an axis)");
     used_grid_ = false;
     const std::size_t n = p.size();
     const Real h = Real(params_.smoothing_length);
@@ -428,6 +560,7 @@ class SphFluid final : public Solver<Real> {
   GridScratch<Real> scratch_;
   std::optional<DfsphKernel<Real>> kernel_;  // DFSPH: built at the first evaluation
   AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
+  AlignedVector<Real> boundary_pressure_;    // thesis's solver: p_b of the last evaluation (scratch)
   double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
   static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
@@ -436,6 +569,9 @@ class SphFluid final : public Solver<Real> {
   double neighbour_sum_ = 0;     // Σ of mean_neighbours_ over evaluations (the summary's mean)
   std::uint64_t evaluations_ = 0;
   bool used_grid_ = false;
+  bool boundary_volumes_ = false;  // ψ_b computed into the boundary particles' masses (state)
+  bool counted_ = false;           // fluid_count_ set
+  std::size_t fluid_count_ = 0;    // fluid particles (static: boundary particles are never added or removed)
 };
 
 }  // namespace swirl::sph
