@@ -170,7 +170,9 @@ function onText(text) {
       ui("stats").textContent = `frame ${m.frame} of ${m.frames - 1} · t = ${Number(m.time).toPrecision(4)} · ` +
         `${m.particles} particles · ${state.fps.toFixed(0)} fps` + (m.at_end ? " · last frame" : "");
       ui("frameinfo").textContent = `frame ${m.frame} / ${m.frames - 1} · t = ${Number(m.time).toPrecision(4)}`;
-      if (!scrubbing) ui("slider").value = m.frame;
+      // The slider follows the frame shown, but not while dragged or while a seek is on its way.
+      if (seek && (m.frame === seek.frame || performance.now() - seek.at > 2000)) seek = null;
+      if (!scrubbing && !seek) ui("slider").value = m.frame;
       return;
     }
     state.history.push({ e: m.kinetic_energy + m.potential_energy, rate: m.steps_per_second });
@@ -202,12 +204,17 @@ function setUpReplay(m) {
   speed.value = "10";
   ui("plot").style.display = "none";
 }
-function sendSeek(i) { const b = new DataView(new ArrayBuffer(5)); b.setUint8(0, 8); b.setUint32(1, i, true); send(b.buffer); }
+let seek = null;  // the frame last asked for, until a status shows it
+function sendSeek(i) {
+  seek = { frame: i, at: performance.now() }; ui("slider").value = i;
+  const b = new DataView(new ArrayBuffer(5)); b.setUint8(0, 8); b.setUint32(1, i, true); send(b.buffer);
+}
+function shownOrAsked() { return seek ? seek.frame : state.status ? state.status.frame : 0; }
 ui("slider").addEventListener("pointerdown", () => { scrubbing = true; });
 ui("slider").addEventListener("pointerup", () => { scrubbing = false; });
 ui("slider").addEventListener("input", (e) => sendSeek(Number(e.target.value)));
-ui("prev").onclick = () => { const s = state.status; if (s && s.frame > 0) sendSeek(s.frame - 1); };
-ui("next").onclick = () => { const s = state.status; if (s && s.frame + 1 < s.frames) sendSeek(s.frame + 1); };
+ui("prev").onclick = () => { const f = shownOrAsked(); if (f > 0) sendSeek(f - 1); };
+ui("next").onclick = () => { const f = shownOrAsked(); if (state.status && f + 1 < state.status.frames) sendSeek(f + 1); };
 
 // ---- Live parameters: viscosity, gravity (strength and tilt), softening ----------------------
 // A slider sends its value when released ("change"): one change, one line in swirl's log.
