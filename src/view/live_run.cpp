@@ -276,7 +276,21 @@ class LiveSession {
     hello_ = std::move(text);
   }
 
+  // The parameters' values as the solvers hold them (what the statuses report).
+  void read_back_parameters() {
+    for (LiveParameter& p : parameters_) {
+      if (p.id == control::ParameterId::Viscosity) {
+        if (const auto* fluid = sim_->template find_solver<sph::SphFluid<Real>>()) p.value = {fluid->parameters().viscosity, 0, 0};
+      } else if (p.id == control::ParameterId::Gravity) {
+        if (const auto* field = sim_->template find_solver<UniformGravity<Real>>()) p.value = field->g().template cast<double>();
+      } else if (const auto* self = sim_->template find_solver<gravity::GravityForce<Real>>()) {
+        p.value = {self->settings().softening, 0, 0};
+      }
+    }
+  }
+
   std::string status() {
+    read_back_parameters();
     const auto now = Clock::now();
     const double dt = std::chrono::duration<double>(now - status_clock_).count();
     const double rate = dt > 0 ? double(steps_ - status_steps_) / dt : 0;

@@ -303,7 +303,7 @@ class ReplaySession {
       todo.swap(controls_);
     }
     std::size_t target = index_;
-    bool recolour = false, changed = false;
+    bool recolour = false, changed = false;  // recolour: publish the frame shown again
     for (const Control& c : todo) {
       if (std::holds_alternative<control::Pause>(c)) {
         playing_ = false, changed = true;
@@ -320,7 +320,7 @@ class ReplaySession {
       } else if (const auto* k = std::get_if<control::Colour>(&c)) {
         if (k->field < fields_.size()) colour_ = k->field, recolour = changed = true;
       } else if (const auto* seek = std::get_if<control::Seek>(&c)) {
-        if (seek->frame < run_.frames.size()) target = seek->frame;
+        if (seek->frame < run_.frames.size()) target = seek->frame, recolour = true;  // answered by a frame, also when shown
         else refuse(fmt::format("seek to frame {}: the run has {} frames (0 to {})", seek->frame, run_.frames.size(),
                                 run_.frames.size() - 1));
       } else if (std::holds_alternative<control::Push>(c)) {

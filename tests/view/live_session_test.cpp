@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <future>
 #include <mutex>
 #include <vector>
@@ -225,6 +226,53 @@ TEST_F(LiveSession, ParameterChangesReachTheSimulationAndOutOfRangeOnesAreRefuse
         line.find("forces.gravity (0, 0, -9.81) m/s² -> (0, 0, 9.81) m/s²") != std::string::npos)
       ++logged;
   EXPECT_EQ(logged, 2) << "each change is logged with its step";
+}
+
+// A gravity run offers the softening (only): a larger ε reaches the tree
+// walk, whose potential energy |W| then drops, where one step without the
+// change leaves it as it was.
+TEST(LiveSessionGravity, TheSofteningSliderReachesTheTreeWalk) {
+  const scene::Scene scene = scene::load_scene(std::string(SWIRL_SOURCE_DIR) + "/examples/plummer.toml",
+                                               std::vector<std::string>{"particles.0.count=400"});
+  std::atomic<bool> stop{false};
+  ViewOptions options;
+  options.threads = 1;
+  options.start_paused = true;
+  options.stop = &stop;
+  std::promise<std::uint16_t> listening;
+  auto port = listening.get_future();
+  options.on_listening = [&listening](const LiveServer& s) { listening.set_value(s.port()); };
+  auto run = std::async(std::launch::async, [&] { return view_scene(scene, options); });
+  {
+    Viewer v(port.get());
+    auto [text, hello] = v.next();
+    EXPECT_NE(hello.find(R"("key":"nbody.softening")"), std::string::npos) << hello;
+    EXPECT_EQ(hello.find("sph.viscosity"), std::string::npos) << hello;
+    EXPECT_EQ(hello.find("forces.gravity"), std::string::npos) << "no uniform field in a Plummer sphere: " << hello;
+    auto step = [&] {  // one step; its status
+      const std::uint64_t s0 = field_u64(test::next_text(v, "status"), "step");
+      v.send(encode_control(control::Step{}));
+      std::string st = test::next_text(v, "status");
+      for (int k = 0; k < 20 && field_u64(st, "step") <= s0; ++k) st = test::next_text(v, "status");
+      return st;
+    };
+    const std::string a = step(), b = step();
+    EXPECT_DOUBLE_EQ(test::json_number_at(b, "nbody.softening"), 0.01);
+    v.send(encode_control(control::Parameter{control::ParameterId::Softening, {0.5f, 0, 0}}));
+    const std::string c = step();
+    EXPECT_DOUBLE_EQ(test::json_number_at(c, "nbody.softening"), 0.5) << c;
+    const double w_a = test::json_number_at(a, "potential_energy"), w_b = test::json_number_at(b, "potential_energy"),
+                 w_c = test::json_number_at(c, "potential_energy");
+    EXPECT_LT(w_a, 0);
+    EXPECT_LT(std::abs(w_b - w_a), 0.01 * std::abs(w_a)) << "one step alone";
+    EXPECT_GT(w_c - w_b, 0.1 * std::abs(w_b)) << "ε = 0.5 makes the potential much shallower";
+    v.send(encode_control(control::Parameter{control::ParameterId::Softening, {-0.01f, 0, 0}}));
+    EXPECT_NE(test::next_text(v, "refused").find("nbody.softening"), std::string::npos);
+  }
+  stop = true;
+  const ViewResult r = run.get();
+  EXPECT_EQ(r.parameter_changes, 1u);
+  EXPECT_EQ(r.refused, 1u);
 }
 
 TEST(PushForce, RelaxesVelocitiesTowardTheDragWithinItsRadiusOnly) {

@@ -24,7 +24,8 @@
 // from the first frame when at the last), pause, step (the next frame), reset
 // (the first frame), speed (frames per second of playback, 0: as fast as
 // frames are read, at most --fps), colour, and seek (a frame by its index).
-// A burst of seeks (a dragged slider) shows only the last. The push and the
+// A burst of seeks (a dragged slider) shows only the last; a seek is always
+// answered by a frame, also one to the frame shown. The push and the
 // live parameters are refused (logged, counted, told to the page). A frame
 // that cannot be read pauses the replay on the frame before, with an error
 // naming the file on the page and in the log.
