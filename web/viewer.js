@@ -240,7 +240,15 @@ function setUpParameters(list) {
       inputs[0].id = "param-" + p.label;
       inputs[0].addEventListener("change", () => sendParameter(p.id, [Number(inputs[0].value), 0, 0]));
     }
-    row.append(text, ...inputs); box.appendChild(row);
+    inputs[0].title = `${p.key}: ${p.min} to ${p.max} ${p.unit}` + (p.vector ? " (|g|)" : "");
+    if (p.vector) {
+      inputs[1].title = "tilt of g from -z toward +x, degrees";
+      const tilt = document.createElement("span"); tilt.textContent = " tilt ";
+      row.append(text, inputs[0], tilt, inputs[1]);
+    } else {
+      row.append(text, ...inputs);
+    }
+    box.appendChild(row);
     sliders[p.key] = { spec: p, inputs, text };
   }
   const values = {}; for (const p of list) values[p.key] = p.value;

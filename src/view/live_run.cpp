@@ -178,11 +178,14 @@ class LiveSession {
     refresh_hello();
   }
 
-  // A control the session cannot follow: logged, told to the viewers, counted.
+  // A control the session cannot follow: told to the viewers, counted, and
+  // logged (the 1st, 10th, 100th, ...: a page cannot flood the terminal).
   void refuse(const std::string& why) {
-    ++refused_;
+    const std::uint64_t k = ++refused_;
+    std::uint64_t power = 1;
+    while (power < k) power *= 10;
     const std::string line = fmt::format("swirl view: refused a control from a viewer: {}", why);
-    if (options_.log) options_.log(line);
+    if (options_.log && power == k) options_.log(fmt::format("{} ({} so far)", line, k));
     server_.announce(fmt::format(R"({{"type":"refused","message":{}}})", json::string(line)));
   }
 
