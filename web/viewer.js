@@ -193,9 +193,9 @@ let scrubbing = false;
 function setUpReplay(m) {
   ui("replay").style.display = "block";
   const slider = ui("slider"); slider.max = Math.max(0, m.frames - 1);
-  // The push and single steps of a simulation do not apply; step is the next frame here.
+  // The live-only controls (the push, a simulation's single step) are hidden: < and > step frames here.
   ui("pushlabel").style.display = "none"; ui("push").checked = false;
-  ui("reset").textContent = "first"; ui("step").textContent = "next";
+  ui("step").style.display = "none"; ui("reset").textContent = "first";
   ui("help").textContent = "drag: orbit · shift+drag: pan · wheel: zoom · slider: any frame";
   const speed = ui("speed"); speed.innerHTML = "";
   for (const [v, t] of [[30, "30 frames/s"], [10, "10 frames/s"], [5, "5 frames/s"], [2, "2 frames/s"], [1, "1 frame/s"]]) {

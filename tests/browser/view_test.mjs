@@ -25,7 +25,7 @@
 //      sent by hand is refused;
 // then, on a run folder `swirl run` writes of the dam break's column (0.2 s, 11 frames):
 //   7. `swirl view RUN_DIR --paused` serves the page in replay mode: the time
-//      slider is shown, the push hidden; a click on the slider shows the
+//      slider is shown, the push and the step hidden; a click on the slider shows the
 //      frame under the pointer (the frames' positions change with it), the
 //      next/previous buttons step one frame, play reaches the last frame, and
 //      a screenshot has particles drawn.
@@ -82,7 +82,7 @@ swirl.stdout.on("data", (d) => { stdout += d; });
 swirl.stderr.on("data", (d) => { stderr += d; });
 const exited = new Promise((r) => swirl.on("exit", (code, signal) => r({ code, signal })));
 let browser = null;
-const watchdog = setTimeout(() => { console.error("FAIL: watchdog (110 s)"); swirl.kill("SIGKILL"); if (browser) browser.process()?.kill("SIGKILL"); process.exit(1); }, 110_000);
+const watchdog = setTimeout(() => { console.error("FAIL: watchdog (170 s)"); swirl.kill("SIGKILL"); if (browser) browser.process()?.kill("SIGKILL"); process.exit(1); }, 170_000);
 
 async function main() {
   let url = null;
@@ -102,8 +102,13 @@ async function main() {
   page.on("response", (r) => { if (r.status() >= 400 && !r.url().endsWith("/favicon.ico")) pageErrors.push(`${r.status()} for ${r.url()}`); });
   await page.goto(url, { waitUntil: "load" });
   const view = (f, ...a) => page.evaluate(f, ...a);
+  // On a time-out: where the page was (its newest frame and status, any message shown).
   const waitFor = (f, what, timeout = 15_000, ...a) =>
-    page.waitForFunction(f, { timeout, polling: 50 }, ...a).catch(() => { throw new Error(`timed out: ${what}`); });
+    page.waitForFunction(f, { timeout, polling: 50 }, ...a).catch(async () => {
+      const where = await view(() => JSON.stringify({ step: window.swirlView.step, received: window.swirlView.received, frames: window.swirlView.frames, status: window.swirlView.status,
+        message: document.getElementById("message").textContent, note: window.swirlView.note })).catch(() => "?");
+      throw new Error(`timed out: ${what}; the page: ${where}`);
+    });
 
   // 1. Frames arrive and are drawn.
   const renderer = await view(() => {
@@ -177,7 +182,7 @@ async function main() {
     await waitFor((t) => window.swirlView.step === t, "a single step's frame", 10_000, s0);
     const a = await meanY();
     await view((n) => { for (let i = 0; i < n; i++) document.getElementById("step").click(); }, kSteps);
-    await waitFor((t) => window.swirlView.step === t, `${kSteps} steps`, 30_000, s0 + kSteps);
+    await waitFor((t) => window.swirlView.step === t, `${kSteps} steps (to step ${s0 + kSteps})`, 30_000, s0 + kSteps);
     const b = await meanY();
     return { d: b.y - a.y, steps: `${a.step}-${b.step}` };
   };
@@ -294,10 +299,11 @@ async function replay() {
       page.waitForFunction(f, { timeout, polling: 50 }, ...a).catch(() => { throw new Error(`timed out: ${what}`); });
     await waitFor(() => window.swirlView.received >= 1 && window.swirlView.status && window.swirlView.frames >= 5, "the first frame");
     const ui = await view(() => ({ mode: window.swirlView.mode, bar: getComputedStyle(document.getElementById("replay")).display,
-      push: getComputedStyle(document.getElementById("pushlabel")).display, max: document.getElementById("slider").max,
-      step: window.swirlView.step }));
-    check(ui.mode === "replay" && ui.bar !== "none" && ui.push === "none" && ui.max === "10" && ui.step === 0,
-      `replay mode: the slider over 11 frames shown, the push hidden, frame 0 first (${JSON.stringify(ui)})`);
+      push: getComputedStyle(document.getElementById("pushlabel")).display,
+      step: getComputedStyle(document.getElementById("step")).display, max: document.getElementById("slider").max,
+      frame: window.swirlView.step }));
+    check(ui.mode === "replay" && ui.bar !== "none" && ui.push === "none" && ui.step === "none" && ui.max === "10" && ui.frame === 0,
+      `replay mode: the slider over 11 frames shown, the push and step hidden, frame 0 first (${JSON.stringify(ui)})`);
     const meanZ = () => view(() => { const v = window.swirlView; let s = 0;
       for (let i = 2; i < v.positions.length; i += 3) s += v.positions[i];
       return { z: v.lo[2] + (s / v.count / 65535) * (v.hi[2] - v.lo[2]), step: v.step }; });
