@@ -81,8 +81,8 @@ let stdout = "", stderr = "";
 swirl.stdout.on("data", (d) => { stdout += d; });
 swirl.stderr.on("data", (d) => { stderr += d; });
 const exited = new Promise((r) => swirl.on("exit", (code, signal) => r({ code, signal })));
-let browser = null;
-const watchdog = setTimeout(() => { console.error("FAIL: watchdog (170 s)"); swirl.kill("SIGKILL"); if (browser) browser.process()?.kill("SIGKILL"); process.exit(1); }, 170_000);
+let browser = null, replaying = null;  // the replay's swirl, while it runs
+const watchdog = setTimeout(() => { console.error("FAIL: watchdog (170 s)"); swirl.kill("SIGKILL"); replaying?.kill("SIGKILL"); if (browser) browser.process()?.kill("SIGKILL"); process.exit(1); }, 170_000);
 
 async function main() {
   let url = null;
@@ -278,7 +278,7 @@ async function replay() {
   const made = spawnSync(swirlPath, ["run", scenePath, "--out", runDir, "--overwrite", "--threads", "2",
     "--set", "particles.0.spacing=0.025", "--set", "simulation.end_time=0.2"], { encoding: "utf8" });
   if (!check(made.status === 0, `swirl run writes a run folder (exit ${made.status})`)) throw new Error(made.stderr);
-  const viewer = spawn(swirlPath, ["view", runDir, "--port", "0", "--seconds", "60", "--paused"], { stdio: ["ignore", "pipe", "pipe"] });
+  const viewer = replaying = spawn(swirlPath, ["view", runDir, "--port", "0", "--seconds", "60", "--paused"], { stdio: ["ignore", "pipe", "pipe"] });
   let out = "", err = "";
   viewer.stdout.on("data", (d) => { out += d; });
   viewer.stderr.on("data", (d) => { err += d; });
