@@ -97,12 +97,13 @@ ReplayFrame read_vtp_frame(const fs::path& file) {
   const auto xyz = floats(vtp.points);
   if (!xyz || vtp.points.components != 3 || xyz->size() != 3 * vtp.num_points)
     throw io::IoError(fmt::format("{}: the points are not {} triples of numbers", file.string(), vtp.num_points));
-  double time = 0;
-  if (const auto it = vtp.field_data.find("TimeValue"); it != vtp.field_data.end())
-    if (const auto t = floats(it->second); t && !t->empty()) time = double(t->front());
-  if (const auto it = vtp.field_data.find("TimeValue"); it != vtp.field_data.end() && it->second.type == "Float64") {
-    const auto t = it->second.values<double>();
-    if (!t.empty()) time = t.front();  // exactly, not through a float
+  double time = 0;  // the frame's TimeValue (swirl writes Float64: read exactly, not through a float)
+  if (const auto it = vtp.field_data.find("TimeValue"); it != vtp.field_data.end()) {
+    if (it->second.type == "Float64") {
+      if (const auto t = it->second.values<double>(); !t.empty()) time = t.front();
+    } else if (const auto t = floats(it->second); t && !t->empty()) {
+      time = double(t->front());
+    }
   }
   std::vector<NamedArray> arrays;
   for (const auto& [name, a] : vtp.point_data) {

@@ -11,7 +11,7 @@
 // today) the view sets one, which the page's slider spans and the session
 // enforces alike: ten times the scene's value for μ and ε (at least 1 Pa·s,
 // at least a tenth of the particles' initial extent), four times |g| for
-// gravity (at least 4 × 9.81 m/s²), so a slider cannot throw the run into a
+// gravity (4 × 9.81 m/s² when the scene's g is 0), so a slider cannot throw the run into a
 // blow-up by a stray drag to an absurd value. Gravity's range bounds |g|; any
 // direction is allowed.
 //
