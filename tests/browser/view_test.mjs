@@ -318,9 +318,12 @@ async function replay() {
       `the slider at frame ${asked}: that frame is shown, the column has fallen (mean z ${(1000 * z0.z).toFixed(1)} -> ${(1000 * zk.z).toFixed(1)} mm)`);
     await page.click("#next");
     await waitFor((k) => window.swirlView.step === k + 1, "the next frame", 10_000, asked);
+    const next = await view(() => window.swirlView.step);
     await page.click("#prev"); await page.click("#prev");
     await waitFor((k) => window.swirlView.step === k - 1, "two frames back", 10_000, asked);
-    check(true, `next and previous step one frame (${asked} -> ${asked + 1} -> ${asked - 1})`);
+    const back = await view(() => ({ step: window.swirlView.step, slider: Number(document.getElementById("slider").value) }));
+    check(next === asked + 1 && back.step === asked - 1 && back.slider === asked - 1,
+      `next and previous step one frame (${asked} -> ${next} -> ${back.step}, the slider at ${back.slider})`);
     await page.click("#play");
     await waitFor(() => window.swirlView.step === 10 && window.swirlView.status.at_end, "the last frame", 15_000);
     const end = await view(() => ({ slider: document.getElementById("slider").value, paused: window.swirlView.paused }));
