@@ -24,13 +24,14 @@ JOBS=${JOBS:-$(nproc)}
 # The test executables whose code runs on several threads: the parallel
 # wrappers, the neighbour search, the thread bit-identity tests of both solvers,
 # the gravity kernels and trees (and their active-set walks for block time steps), the renderer's tiles, the adaptive step's
-# reductions and the concurrent atomic file writes.
+# reductions, the concurrent atomic file writes, and swirl view's threads (the
+# simulation's, the encoder's, the server's; the replay's session and server).
 DEFAULT_TARGETS="parallel_for_blocks_test parallel_radix_sort_test spatial_spatial_hash_test spatial_cell_grid_test
 sim_threads_test sim_adaptive_test sph_sph_fluid_test sph_grid_strategy_test
 gravity_schemes_test gravity_direct_sum_test gravity_diagnostics_test gravity_bench_test gravity_linear_tree_test
 render_splats_test render_surface_density_test render_run_renderer_test io_atomic_file_test
 sph_grid_skin_test sph_grid_dispatch_test gravity_group_walk_test gravity_block_steps_test
-gravity_fmm_test sim_dfsph_test"
+gravity_fmm_test sim_dfsph_test view_live_session_test view_replay_test"
 # shellcheck disable=SC2206 # a list of target names, split on white space
 TARGETS=(${SWIRL_TSAN_TARGETS:-$DEFAULT_TARGETS})
 start=$SECONDS

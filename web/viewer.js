@@ -13,14 +13,18 @@ const state = {
   hello: null, frame: null, count: 0, lo: [0, 0, 0], hi: [1, 1, 1],
   yaw: 0.6, pitch: 0.35, distance: 3, target: [0, 0, 0], framed: false,
   paused: false, status: null, history: [], frames: 0, lastDraw: performance.now(), fps: 0,
-  positions: null, frameMs: [],
+  positions: null, frameMs: [], mode: "live", parameters: {}, note: "",
 };
 // The test hook (tests/browser/view_test.mjs, tools/view_overhead.mjs) and the
 // console: window.swirlView is this state: hello (the server's hello), step and
 // time (newest frame's), lo/hi (its quantisation box), count and positions
 // (its u16 x,y,z triples: lo + q/65535·(hi − lo)), received (frames decoded),
 // status (newest status message: step, paused, steps_per_second...), paused,
-// frames (drawn) and frameMs (the last 240 intervals between drawn frames, ms).
+// frames (drawn) and frameMs (the last 240 intervals between drawn frames, ms);
+// mode ("live" or "replay": then step is the frame's index in the run and
+// status.frame / status.frames say where the replay is), parameters (the live
+// parameters' current values by scene key, from the newest status) and note
+// (the last parameter change or refusal the server reported).
 // The camera (yaw, pitch, distance, target) may be set; worldAt(x, y) is global.
 window.swirlView = state;
 
@@ -157,17 +161,111 @@ function onText(text) {
     m.fields.forEach((f, i) => { const o = document.createElement("option"); o.value = i; o.textContent = f; sel.appendChild(o); });
     sel.value = m.colour;
     setPaused(m.paused);
+    state.mode = m.mode || "live";
+    if (state.mode === "replay") setUpReplay(m); else setUpParameters(m.parameters || []);
   } else if (m.type === "status") {
     state.status = m;
     setPaused(m.paused || m.at_end);
+    if (m.mode === "replay") {
+      ui("stats").textContent = `frame ${m.frame} of ${m.frames - 1} · t = ${Number(m.time).toPrecision(4)} · ` +
+        `${m.particles} particles · ${state.fps.toFixed(0)} fps` + (m.at_end ? " · last frame" : "");
+      ui("frameinfo").textContent = `frame ${m.frame} / ${m.frames - 1} · t = ${Number(m.time).toPrecision(4)}`;
+      // The slider follows the frame shown, but not while dragged or while a seek is on its way.
+      if (seek && (m.frame === seek.frame || performance.now() - seek.at > 2000)) seek = null;
+      if (!scrubbing && !seek) ui("slider").value = m.frame;
+      return;
+    }
     state.history.push({ e: m.kinetic_energy + m.potential_energy, rate: m.steps_per_second });
     if (state.history.length > 240) state.history.shift();
     ui("stats").textContent = `step ${m.step} · t = ${Number(m.time).toPrecision(4)} · ${m.steps_per_second.toFixed(1)} steps/s · ` +
       `${state.fps.toFixed(0)} fps` + (m.at_end ? " · end of run" : "");
+    if (m.parameters) showParameters(m.parameters);
     plot();
   } else if (m.type === "error") {
     const box = ui("message"); box.textContent = m.message; box.style.display = "block";
+  } else if (m.type === "parameter" || m.type === "refused") {
+    state.note = m.message; ui("note").textContent = m.message.replace(/^swirl view: /, "");
   }
+}
+
+// ---- Replay: the time slider ------------------------------------------------------------
+let scrubbing = false;
+function setUpReplay(m) {
+  ui("replay").style.display = "block";
+  const slider = ui("slider"); slider.max = Math.max(0, m.frames - 1);
+  // The live-only controls (the push, a simulation's single step) are hidden: < and > step frames here.
+  ui("pushlabel").style.display = "none"; ui("push").checked = false;
+  ui("step").style.display = "none"; ui("reset").textContent = "first";
+  ui("help").textContent = "drag: orbit · shift+drag: pan · wheel: zoom · slider: any frame";
+  const speed = ui("speed"); speed.innerHTML = "";
+  for (const [v, t] of [[30, "30 frames/s"], [10, "10 frames/s"], [5, "5 frames/s"], [2, "2 frames/s"], [1, "1 frame/s"]]) {
+    const o = document.createElement("option"); o.value = v; o.textContent = t; speed.appendChild(o);
+  }
+  speed.value = "10";
+  ui("plot").style.display = "none";
+}
+let seek = null;  // the frame last asked for, until a status shows it
+function sendSeek(i) {
+  seek = { frame: i, at: performance.now() }; ui("slider").value = i;
+  const b = new DataView(new ArrayBuffer(5)); b.setUint8(0, 8); b.setUint32(1, i, true); send(b.buffer);
+}
+function shownOrAsked() { return seek ? seek.frame : state.status ? state.status.frame : 0; }
+ui("slider").addEventListener("pointerdown", () => { scrubbing = true; });
+ui("slider").addEventListener("pointerup", () => { scrubbing = false; });
+ui("slider").addEventListener("input", (e) => sendSeek(Number(e.target.value)));
+ui("prev").onclick = () => { const f = shownOrAsked(); if (f > 0) sendSeek(f - 1); };
+ui("next").onclick = () => { const f = shownOrAsked(); if (state.status && f + 1 < state.status.frames) sendSeek(f + 1); };
+
+// ---- Live parameters: viscosity, gravity (strength and tilt), softening ----------------------
+// A slider sends its value when released ("change"): one change, one line in swirl's log.
+const sliders = {};  // by scene key: {spec, inputs, label}
+function fmt(v) { return Math.abs(v) >= 1e4 || (Math.abs(v) < 1e-3 && v !== 0) ? v.toExponential(2) : Number(v.toPrecision(3)).toString(); }
+function setUpParameters(list) {
+  const box = ui("params"); box.innerHTML = ""; box.style.display = list.length ? "block" : "none";
+  for (const p of list) {
+    const row = document.createElement("label"), text = document.createElement("span");
+    const make = (min, max, value, step) => { const r = document.createElement("input"); r.type = "range";
+      r.min = min; r.max = max; r.step = step; r.value = value; r.dataset.key = p.key; return r; };
+    let inputs;
+    if (p.vector) {  // strength |g| and the tilt from -z toward +x, in degrees
+      const g = p.value, s = Math.hypot(g[0], g[1], g[2]);
+      const tilt = s > 0 ? Math.atan2(g[0], -g[2]) * 180 / Math.PI : 0;
+      inputs = [make(p.min, p.max, s, (p.max - p.min) / 200), make(-90, 90, Math.max(-90, Math.min(90, tilt)), 1)];
+      inputs[0].id = "param-gravity"; inputs[1].id = "param-gravity-tilt";
+      const send_g = () => { const s = Number(inputs[0].value), t = Number(inputs[1].value) * Math.PI / 180;
+        sendParameter(p.id, [s * Math.sin(t), 0, -s * Math.cos(t)]); };
+      inputs.forEach((r) => r.addEventListener("change", send_g));
+    } else {
+      inputs = [make(p.min, p.max, p.value, (p.max - p.min) / 200)];
+      inputs[0].id = "param-" + p.label;
+      inputs[0].addEventListener("change", () => sendParameter(p.id, [Number(inputs[0].value), 0, 0]));
+    }
+    inputs[0].title = `${p.key}: ${p.min} to ${p.max} ${p.unit}` + (p.vector ? " (|g|)" : "");
+    if (p.vector) {
+      inputs[1].title = "tilt of g from -z toward +x, degrees";
+      const tilt = document.createElement("span"); tilt.textContent = " tilt ";
+      row.append(text, inputs[0], tilt, inputs[1]);
+    } else {
+      row.append(text, ...inputs);
+    }
+    box.appendChild(row);
+    sliders[p.key] = { spec: p, inputs, text };
+  }
+  const values = {}; for (const p of list) values[p.key] = p.value;
+  showParameters(values);
+}
+function showParameters(values) {
+  state.parameters = values;
+  for (const [key, v] of Object.entries(values)) {
+    const s = sliders[key]; if (!s) continue;
+    const unit = s.spec.unit ? " " + s.spec.unit : "";
+    s.text.textContent = s.spec.vector ? `${s.spec.label} (${v.map(fmt).join(", ")})${unit} ` : `${s.spec.label} ${fmt(v)}${unit} `;
+    if (!s.spec.vector && document.activeElement !== s.inputs[0]) s.inputs[0].value = v;
+  }
+}
+function sendParameter(id, v) {
+  const b = new DataView(new ArrayBuffer(14)); b.setUint8(0, 9); b.setUint8(1, id);
+  v.forEach((x, i) => b.setFloat32(2 + 4 * i, x, true)); send(b.buffer);
 }
 function plot() {
   const c = ui("plot"), g = c.getContext("2d"); g.clearRect(0, 0, c.width, c.height);

@@ -35,6 +35,16 @@ GravityForce<Real>::GravityForce(const GravitySettings& settings, const SelfGrav
 }
 
 template <class Real>
+void GravityForce<Real>::set_softening(double softening) {
+  GravitySettings changed = settings_;
+  changed.softening = softening;
+  validate(changed);  // std::invalid_argument for a negative or non-finite ε
+  settings_ = changed;
+  tree_ = BarnesHut<Real>(settings_);  // the trees read ε from their settings at each evaluation
+  fmm_ = Fmm<Real>(fmm_settings(settings_));
+}
+
+template <class Real>
 bool GravityForce<Real>::views_order() const {
   if (settings_.method == Method::Fmm) return settings_.reorder;
   return settings_.method == Method::BarnesHut && settings_.reorder && tree_.uses_linear_tree();

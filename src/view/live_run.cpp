@@ -13,33 +13,16 @@
 
 #include <fmt/format.h>
 
+#include "json.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sim/build.hpp"
+#include "swirl/view/parameters.hpp"
 #include "swirl/view/push_force.hpp"
 
 namespace swirl::view {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// A JSON string literal (quotes, backslashes and control characters escaped).
-std::string json_string(std::string_view s) {
-  std::string out(1, '"');
-  for (const char c : s) {
-    if (c == '"' || c == '\\') {
-      out.push_back('\\');
-      out.push_back(c);
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      out.append(fmt::format("\\u{:04x}", static_cast<unsigned char>(c)));
-    } else {
-      out.push_back(c);
-    }
-  }
-  out.push_back('"');
-  return out;
-}
-
-std::string json_number(double v) { return std::isfinite(v) ? fmt::format("{:.9g}", v) : std::string("null"); }
 
 // What can colour the particles: the speed, then every output scalar field
 // (density, pressure, potential, ...) and integer field (a kind, a time bin).
@@ -72,6 +55,11 @@ class LiveSession {
         server_(
             options.server, [this](const Control& c) { receive(c); }, [this] { return hello(); },
             options.log) {}
+  // The server's thread calls hello(): it only reads the text the simulation's thread left.
+  std::string hello() {
+    std::lock_guard lock(hello_mutex_);
+    return hello_;
+  }
 
   ViewResult run() {
     const auto t0 = Clock::now();
@@ -111,6 +99,8 @@ class LiveSession {
     ViewResult r;
     r.steps = steps_;
     r.resets = resets_;
+    r.parameter_changes = changes_;
+    r.refused = refused_;
     r.wall_seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     r.setup_seconds = std::chrono::duration<double>(t_built - t0).count();
     r.server = server_.stats();
@@ -119,13 +109,84 @@ class LiveSession {
 
  private:
   void build() {
+    {
+      std::lock_guard lock(push_mutex_);  // the server's thread may be handing the old force a push
+      push_ = nullptr;
+    }
     sim_ = std::make_unique<Simulation<Real>>(sim::build_simulation<Real>(scene_));
+    if (parameters_.empty()) parameters_ = live_parameters(scene_, extent(sim_->particles()));
+    // The gravity slider needs the uniform field, also where its g is (set to) zero.
+    const bool offers_gravity = std::any_of(parameters_.begin(), parameters_.end(),
+                                            [](const LiveParameter& p) { return p.id == control::ParameterId::Gravity; });
+    if (offers_gravity && !sim_->template find_solver<UniformGravity<Real>>())
+      sim_->add_solver(std::make_unique<UniformGravity<Real>>(scene_.gravity.template cast<Real>()));
     auto push = std::make_unique<PushForce<Real>>();
-    push_ = push.get();
+    {
+      std::lock_guard lock(push_mutex_);
+      push_ = push.get();
+    }
     sim_->add_solver(std::move(push));
     sim_->start();
     fields_ = colourings(sim_->particles());
     at_end_ = false;
+    refresh_hello();
+  }
+
+  // The largest side of the particles' bounds (the softening slider's scale).
+  static double extent(const ParticleSet<Real>& p) {
+    if (p.empty()) return 0;
+    Vec3d lo{INFINITY, INFINITY, INFINITY}, hi{-INFINITY, -INFINITY, -INFINITY};
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Vec3d x{double(p.position.x[i]), double(p.position.y[i]), double(p.position.z[i])};
+      lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+      hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+    }
+    return std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+  }
+
+  // A parameter's new value from a page: checked against its range, then set
+  // in the solver between steps (here, on the simulation's thread), in the
+  // scene a reset rebuilds, logged and told to every viewer.
+  void set_parameter(const control::Parameter& c) {
+    const auto it = std::find_if(parameters_.begin(), parameters_.end(),
+                                 [&](const LiveParameter& p) { return p.id == c.id; });
+    const Vec3d value{double(c.value.x), double(c.value.y), double(c.value.z)};
+    std::string why = it == parameters_.end() ? fmt::format("this run has no parameter {}", int(c.id)) : refusal(*it, value);
+    if (!why.empty()) return refuse(why);
+    LiveParameter& p = *it;
+    for (const auto& s : sim_->solvers()) {
+      if (p.id == control::ParameterId::Viscosity) {
+        if (auto* fluid = dynamic_cast<sph::SphFluid<Real>*>(s.get())) fluid->set_viscosity(value.x);
+      } else if (p.id == control::ParameterId::Gravity) {
+        if (auto* field = dynamic_cast<UniformGravity<Real>*>(s.get())) field->set_g(value.template cast<Real>());
+      } else if (auto* self = dynamic_cast<gravity::GravityForce<Real>*>(s.get())) {
+        self->set_softening(value.x);
+      }
+    }
+    sim_->parameters_changed();
+    const std::string line = fmt::format("swirl view: step {} (t = {:.6g}): {} {} -> {} (set by a viewer; the run "
+                                         "from here is not the scene file's)",
+                                         sim_->step_count(), sim_->time(), p.key, value_text(p, p.value),
+                                         value_text(p, value));
+    p.value = value;
+    set_in_scene(scene_, p, value);
+    ++changes_;
+    if (options_.log) options_.log(line);
+    server_.announce(fmt::format(R"({{"type":"parameter","key":{},"step":{},"time":{},"message":{}}})", json::string(p.key),
+                                 sim_->step_count(), json::number(sim_->time()), json::string(line)));
+    server_.announce(status());
+    refresh_hello();
+  }
+
+  // A control the session cannot follow: told to the viewers, counted, and
+  // logged (the 1st, 10th, 100th, ...: a page cannot flood the terminal).
+  void refuse(const std::string& why) {
+    const std::uint64_t k = ++refused_;
+    std::uint64_t power = 1;
+    while (power < k) power *= 10;
+    const std::string line = fmt::format("swirl view: refused a control from a viewer: {}", why);
+    if (options_.log && power == k) options_.log(fmt::format("{} ({} so far)", line, k));
+    server_.announce(fmt::format(R"({{"type":"refused","message":{}}})", json::string(line)));
   }
 
   void step() {
@@ -134,7 +195,8 @@ class LiveSession {
       ++steps_;
     } catch (const SimulationError& e) {
       paused_ = true;
-      server_.announce(fmt::format(R"({{"type":"error","message":{}}})", json_string(e.what())));
+      refresh_hello();
+      server_.announce(fmt::format(R"({{"type":"error","message":{}}})", json::string(e.what())));
       if (options_.log) options_.log(fmt::format("swirl view: {} (paused; reset starts over)", e.what()));
       return;
     }
@@ -162,8 +224,8 @@ class LiveSession {
       todo.swap(controls_);
     }
     for (const Control& c : todo) {
-      if (std::holds_alternative<control::Pause>(c)) paused_ = true;
-      else if (std::holds_alternative<control::Resume>(c)) paused_ = false, pending_steps_ = 0;
+      if (std::holds_alternative<control::Pause>(c)) paused_ = true, refresh_hello();
+      else if (std::holds_alternative<control::Resume>(c)) paused_ = false, pending_steps_ = 0, refresh_hello();
       else if (std::holds_alternative<control::Step>(c)) pending_steps_ += paused_ ? 1 : 0;
       else if (std::holds_alternative<control::Reset>(c)) {
         build();
@@ -174,7 +236,11 @@ class LiveSession {
       } else if (const auto* s = std::get_if<control::Speed>(&c)) {
         speed_ = s->steps_per_second;
       } else if (const auto* k = std::get_if<control::Colour>(&c)) {
-        if (k->field < fields_.size()) colour_ = k->field, recolour_ = true;
+        if (k->field < fields_.size()) colour_ = k->field, recolour_ = true, refresh_hello();
+      } else if (const auto* v = std::get_if<control::Parameter>(&c)) {
+        set_parameter(*v);
+      } else if (std::holds_alternative<control::Seek>(c)) {
+        refuse("seek is for a replay (swirl view RUN_DIR), not a live run");
       }
     }
   }
@@ -182,6 +248,7 @@ class LiveSession {
   // On the server's thread: a push goes straight to the force; the rest waits for the next step boundary.
   void receive(const Control& c) {
     if (const auto* p = std::get_if<control::Push>(&c)) {
+      std::lock_guard lock(push_mutex_);
       if (push_) push_->set(*p);
       return;
     }
@@ -192,22 +259,41 @@ class LiveSession {
     wake_.notify_all();
   }
 
-  std::string hello() {
+  // The hello a new viewer receives, made on the simulation's thread whenever what it says changes.
+  void refresh_hello() {
     std::string fields;
     for (const auto& f : fields_) {
       if (!fields.empty()) fields += ',';
-      fields += json_string(f.name);
+      fields += json::string(f.name);
     }
     std::string box = "null";
     if (scene_.walls)
       box = fmt::format("[{},{},{},{},{},{}]", scene_.box.lo.x, scene_.box.lo.y, scene_.box.lo.z, scene_.box.hi.x,
                         scene_.box.hi.y, scene_.box.hi.z);
-    return fmt::format(R"({{"type":"hello","scene":{},"particles":{},"fields":[{}],"colour":{},"box":{},"gravity":{},"sph":{},"paused":{}}})",
-                       json_string(scene_.file), sim_ ? sim_->particles().size() : 0, fields, colour_, box,
-                       scene_.nbody ? "true" : "false", scene_.sph ? "true" : "false", paused_ ? "true" : "false");
+    std::string text = fmt::format(
+        R"({{"type":"hello","mode":"live","scene":{},"particles":{},"fields":[{}],"colour":{},"box":{},"gravity":{},"sph":{},"paused":{},"parameters":{}}})",
+        json::string(scene_.file), sim_ ? sim_->particles().size() : 0, fields, colour_.load(), box,
+        scene_.nbody ? "true" : "false", scene_.sph ? "true" : "false", paused_ ? "true" : "false",
+        parameters_json(parameters_));
+    std::lock_guard lock(hello_mutex_);
+    hello_ = std::move(text);
+  }
+
+  // The parameters' values as the solvers hold them (what the statuses report).
+  void read_back_parameters() {
+    for (LiveParameter& p : parameters_) {
+      if (p.id == control::ParameterId::Viscosity) {
+        if (const auto* fluid = sim_->template find_solver<sph::SphFluid<Real>>()) p.value = {fluid->parameters().viscosity, 0, 0};
+      } else if (p.id == control::ParameterId::Gravity) {
+        if (const auto* field = sim_->template find_solver<UniformGravity<Real>>()) p.value = field->g().template cast<double>();
+      } else if (const auto* self = sim_->template find_solver<gravity::GravityForce<Real>>()) {
+        p.value = {self->settings().softening, 0, 0};
+      }
+    }
   }
 
   std::string status() {
+    read_back_parameters();
     const auto now = Clock::now();
     const double dt = std::chrono::duration<double>(now - status_clock_).count();
     const double rate = dt > 0 ? double(steps_ - status_steps_) / dt : 0;
@@ -221,9 +307,9 @@ class LiveSession {
     double potential = 0;
     for (const auto& s : sim_->solvers()) potential += s->potential_energy(p, sim_->settings().block_size);
     return fmt::format(
-        R"({{"type":"status","step":{},"time":{},"steps_per_second":{},"paused":{},"at_end":{},"kinetic_energy":{},"potential_energy":{}}})",
-        sim_->step_count(), json_number(sim_->time()), json_number(rate), paused_ ? "true" : "false",
-        at_end_ ? "true" : "false", json_number(kinetic), json_number(potential));
+        R"({{"type":"status","mode":"live","step":{},"time":{},"steps_per_second":{},"paused":{},"at_end":{},"kinetic_energy":{},"potential_energy":{},"parameters":{}}})",
+        sim_->step_count(), json::number(sim_->time()), json::number(rate), paused_ ? "true" : "false",
+        at_end_ ? "true" : "false", json::number(kinetic), json::number(potential), parameter_values_json(parameters_));
   }
 
   // Copies the state for the encoder when it is idle and a frame is due (or forced).
@@ -303,9 +389,14 @@ class LiveSession {
     }
   }
 
-  const scene::Scene& scene_;
+  scene::Scene scene_;  // the scene, with the live parameters' values changed so far (a reset rebuilds it)
   const ViewOptions& options_;
   std::unique_ptr<Simulation<Real>> sim_;
+  std::vector<LiveParameter> parameters_;
+  std::uint64_t changes_ = 0, refused_ = 0;
+  std::mutex hello_mutex_;
+  std::string hello_;
+  std::mutex push_mutex_;  // push_: replaced on the simulation's thread (reset), used on the server's
   PushForce<Real>* push_ = nullptr;
   std::vector<Colouring> fields_;
   std::atomic<std::size_t> colour_{0};

@@ -111,8 +111,10 @@ DecodedFrame decode_frame(std::span<const std::uint8_t> m) {
 }
 
 namespace {
-enum Kind : std::uint8_t { kPause = 1, kResume = 2, kStep = 3, kReset = 4, kSpeed = 5, kColour = 6, kPush = 7 };
-constexpr std::size_t kPayload[] = {0, 0, 0, 0, 0, 4, 1, 33};  // bytes after the kind, by kind
+enum Kind : std::uint8_t {
+  kPause = 1, kResume = 2, kStep = 3, kReset = 4, kSpeed = 5, kColour = 6, kPush = 7, kSeek = 8, kParameter = 9
+};
+constexpr std::size_t kPayload[] = {0, 0, 0, 0, 0, 4, 1, 33, 4, 13};  // bytes after the kind, by kind
 
 Parsed refuse(std::string why) { return Parsed{std::nullopt, std::move(why)}; }
 }  // namespace
@@ -120,7 +122,7 @@ Parsed refuse(std::string why) { return Parsed{std::nullopt, std::move(why)}; }
 Parsed parse_control(std::span<const std::uint8_t> m) {
   if (m.empty()) return refuse("an empty message");
   const std::uint8_t kind = m[0];
-  if (kind < kPause || kind > kPush) return refuse(fmt::format("unknown control kind {}", kind));
+  if (kind < kPause || kind > kParameter) return refuse(fmt::format("unknown control kind {}", kind));
   if (m.size() != 1 + kPayload[kind])
     return refuse(fmt::format("control kind {} has {} bytes, expected {}", kind, m.size(), 1 + kPayload[kind]));
   auto f32 = [&](std::size_t k) { return get<float>(m, 1 + 4 * k); };
@@ -135,6 +137,17 @@ Parsed parse_control(std::span<const std::uint8_t> m) {
       return {control::Speed{s}, {}};
     }
     case kColour: return {control::Colour{m[1]}, {}};
+    case kSeek: return {control::Seek{get<std::uint32_t>(m, 1)}, {}};
+    case kParameter: {
+      if (m[1] >= control::kParameterCount) return refuse(fmt::format("parameter: unknown parameter {}", m[1]));
+      const auto v = [&](std::size_t k) { return get<float>(m, 2 + 4 * k); };
+      for (std::size_t k = 0; k < 3; ++k)
+        if (!std::isfinite(v(k))) return refuse("parameter: a value is not finite");
+      const auto id = static_cast<control::ParameterId>(m[1]);
+      if (id != control::ParameterId::Gravity && (v(1) != 0 || v(2) != 0))
+        return refuse("parameter: a scalar parameter's y and z must be 0");
+      return {control::Parameter{id, {v(0), v(1), v(2)}}, {}};
+    }
     default: {
       control::Push p;
       for (int k = 0; k < 8; ++k)
@@ -166,6 +179,13 @@ std::string encode_control(const Control& c) {
         } else if constexpr (std::is_same_v<T, control::Colour>) {
           out.push_back(char(kColour));
           out.push_back(char(v.field));
+        } else if constexpr (std::is_same_v<T, control::Seek>) {
+          out.push_back(char(kSeek));
+          put(out, v.frame);
+        } else if constexpr (std::is_same_v<T, control::Parameter>) {
+          out.push_back(char(kParameter));
+          out.push_back(char(v.id));
+          for (const float x : {v.value.x, v.value.y, v.value.z}) put(out, x);
         } else {
           out.push_back(char(kPush));
           for (const float x : {v.point.x, v.point.y, v.point.z, v.velocity.x, v.velocity.y, v.velocity.z, v.radius, v.strength})

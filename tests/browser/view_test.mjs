@@ -18,10 +18,21 @@
 //   5. a second WebSocket opened from the page sends malformed controls and an
 //      oversized message: the server closes that socket only, the page's
 //      viewer keeps receiving frames of a running simulation, and swirl
-//      reports the messages dropped at exit.
+//      reports the messages dropped at exit;
+//   6. a live parameter: the viscosity slider (2 Pa·s) set to 3 Pa·s and
+//      released: the status reads 3 back from the solver, the slider's label
+//      shows it, swirl logs the change, and a value over the slider's maximum
+//      sent by hand is refused;
+// then, on a run folder `swirl run` writes of the dam break's column (0.2 s, 11 frames):
+//   7. `swirl view RUN_DIR --paused` serves the page in replay mode: the time
+//      slider is shown, the push and the step hidden; a click on the slider shows the
+//      frame under the pointer (the frames' positions change with it), the
+//      next/previous buttons step one frame, play reaches the last frame, and
+//      a screenshot has particles drawn.
 // The page's test hook is window.swirlView (web/viewer.js).
-import { spawn } from "node:child_process";
+import { spawn, spawnSync } from "node:child_process";
 import fs from "node:fs";
+import os from "node:os";
 import path from "node:path";
 
 const arg = (name, fallback) => {
@@ -59,19 +70,19 @@ let failures = 0;
 const check = (ok, what) => { log(ok ? "ok  " : "FAIL", what); if (!ok) failures++; return ok; };
 
 // ---- swirl view ----------------------------------------------------------------
+// The dam break's water as a pool 0.2 m deep in a 0.6 m box: 24 x 20 x 8 = 3840
+// particles, symmetric across y (no jitter), so only a push moves its mean y
+// much; a higher viscosity calms its sloshing (it starts as a lattice).
+const pool = ["--set", "box.max=[0.6, 0.5, 0.6]", "--set", "particles.0.max=[0.6, 0.5, 0.2]",
+  "--set", "particles.0.spacing=0.025", "--set", "particles.0.jitter=0.0", "--set", "sph.viscosity=2.0"];
 const swirl = spawn(swirlPath, ["view", scenePath, "--port", "0", "--seconds", "120", "--threads", "2",
-  // The dam break's water as a pool 0.2 m deep in a 0.6 m box: 24 x 20 x 8 = 3840
-  // particles, symmetric across y (no jitter), so only a push moves its mean y
-  // much; a higher viscosity calms its sloshing (it starts as a lattice).
-  "--set", "box.max=[0.6, 0.5, 0.6]", "--set", "particles.0.max=[0.6, 0.5, 0.2]",
-  "--set", "particles.0.spacing=0.025", "--set", "particles.0.jitter=0.0", "--set", "simulation.end_time=1000", "--set", "sph.viscosity=2.0",
-  ], { stdio: ["ignore", "pipe", "pipe"] });
+  ...pool, "--set", "simulation.end_time=1000"], { stdio: ["ignore", "pipe", "pipe"] });
 let stdout = "", stderr = "";
 swirl.stdout.on("data", (d) => { stdout += d; });
 swirl.stderr.on("data", (d) => { stderr += d; });
 const exited = new Promise((r) => swirl.on("exit", (code, signal) => r({ code, signal })));
-let browser = null;
-const watchdog = setTimeout(() => { console.error("FAIL: watchdog (90 s)"); swirl.kill("SIGKILL"); if (browser) browser.process()?.kill("SIGKILL"); process.exit(1); }, 90_000);
+let browser = null, replaying = null;  // the replay's swirl, while it runs
+const watchdog = setTimeout(() => { console.error("FAIL: watchdog (170 s)"); swirl.kill("SIGKILL"); replaying?.kill("SIGKILL"); if (browser) browser.process()?.kill("SIGKILL"); process.exit(1); }, 170_000);
 
 async function main() {
   let url = null;
@@ -91,8 +102,13 @@ async function main() {
   page.on("response", (r) => { if (r.status() >= 400 && !r.url().endsWith("/favicon.ico")) pageErrors.push(`${r.status()} for ${r.url()}`); });
   await page.goto(url, { waitUntil: "load" });
   const view = (f, ...a) => page.evaluate(f, ...a);
+  // On a time-out: where the page was (its newest frame and status, any message shown).
   const waitFor = (f, what, timeout = 15_000, ...a) =>
-    page.waitForFunction(f, { timeout, polling: 50 }, ...a).catch(() => { throw new Error(`timed out: ${what}`); });
+    page.waitForFunction(f, { timeout, polling: 50 }, ...a).catch(async () => {
+      const where = await view(() => JSON.stringify({ step: window.swirlView.step, received: window.swirlView.received, frames: window.swirlView.frames, status: window.swirlView.status,
+        message: document.getElementById("message").textContent, note: window.swirlView.note })).catch(() => "?");
+      throw new Error(`timed out: ${what}; the page: ${where}`);
+    });
 
   // 1. Frames arrive and are drawn.
   const renderer = await view(() => {
@@ -166,7 +182,7 @@ async function main() {
     await waitFor((t) => window.swirlView.step === t, "a single step's frame", 10_000, s0);
     const a = await meanY();
     await view((n) => { for (let i = 0; i < n; i++) document.getElementById("step").click(); }, kSteps);
-    await waitFor((t) => window.swirlView.step === t, `${kSteps} steps`, 30_000, s0 + kSteps);
+    await waitFor((t) => window.swirlView.step === t, `${kSteps} steps (to step ${s0 + kSteps})`, 30_000, s0 + kSteps);
     const b = await meanY();
     return { d: b.y - a.y, steps: `${a.step}-${b.step}` };
   };
@@ -218,6 +234,23 @@ async function main() {
   const after = await view(() => ({ r: window.swirlView.received, s: window.swirlView.step, paused: window.swirlView.paused }));
   check(after.r > before.r + 2 && after.s > before.s && !after.paused,
     `the viewer goes on: ${after.r - before.r} frames in 2 s, step ${before.s} -> ${after.s}`);
+
+  // 6. The viscosity slider: set and released (the "change" a release fires).
+  const spec = await view(() => {
+    const r = document.getElementById("param-viscosity");
+    return r ? { min: Number(r.min), max: Number(r.max), value: Number(r.value) } : null;
+  });
+  check(spec && spec.value === 2 && spec.min === 0 && spec.max === 20,
+    `the viscosity slider shows the scene's 2 Pa·s in [0, 20] (${JSON.stringify(spec)})`);
+  await view(() => { const r = document.getElementById("param-viscosity"); r.value = 3; r.dispatchEvent(new Event("change")); });
+  await waitFor(() => window.swirlView.status.parameters["sph.viscosity"] === 3, "the viscosity's new value in a status");
+  const label = await view(() => document.getElementById("param-viscosity").parentElement.textContent);
+  check(/viscosity 3 Pa·s/.test(label), `the slider's label shows the new value ("${label.trim()}")`);
+  await view(() => { const b = new DataView(new ArrayBuffer(14)); b.setUint8(0, 9); b.setUint8(1, 0); b.setFloat32(2, 50, true);
+    const ws = new WebSocket(`ws://${location.host}/ws`); ws.binaryType = "arraybuffer"; ws.onopen = () => ws.send(b.buffer); });
+  await waitFor(() => /outside \[0, 20\]/.test(window.swirlView.note), "the refusal of 50 Pa·s", 10_000);
+  const v3 = await view(() => window.swirlView.status.parameters["sph.viscosity"]);
+  check(v3 === 3, `a viscosity over the slider's range is refused: still ${v3} Pa·s`);
   check(pageErrors.length === 0, `no script errors on the page${pageErrors.length ? ": " + pageErrors.join("; ") : ""}`);
   const frameMs = await view(() => { const a = [...window.swirlView.frameMs].sort((x, y) => x - y); return a[a.length >> 1]; });
   log(`page: median ${frameMs.toFixed(1)} ms between drawn frames (software WebGL2)`);
@@ -235,6 +268,91 @@ const summary = stdout.match(/(\d+) steps in .* (\d+) controls, (\d+) dropped, (
 log(summary ? summary[0] : `swirl's output: ${stdout} ${stderr}`);
 check(end.code === 0, `swirl view ends cleanly (exit ${end.code}, signal ${end.signal})`);
 check(summary && Number(summary[3]) >= 5, `swirl counts the malformed messages dropped (${summary && summary[3]})`);
+check(/sph\.viscosity 2 Pa·s -> 3 Pa·s/.test(stderr), "swirl logs the viscosity's change with its step");
+check(/1 parameter changes, 1 refused/.test(stdout), `swirl counts the change and the refusal (${(stdout.match(/\d+ parameter changes, \d+ refused/) || ["?"])[0]})`);
+
+// ---- 7. swirl view RUN_DIR ------------------------------------------------------------
+const runDir = fs.mkdtempSync(path.join(os.tmpdir(), "swirl-replay-"));
+async function replay() {
+  // The dam break's column (3840 particles), falling for 0.2 s: 11 frames.
+  const made = spawnSync(swirlPath, ["run", scenePath, "--out", runDir, "--overwrite", "--threads", "2",
+    "--set", "particles.0.spacing=0.025", "--set", "simulation.end_time=0.2"], { encoding: "utf8" });
+  if (!check(made.status === 0, `swirl run writes a run folder (exit ${made.status})`)) throw new Error(made.stderr);
+  const viewer = replaying = spawn(swirlPath, ["view", runDir, "--port", "0", "--seconds", "60", "--paused"], { stdio: ["ignore", "pipe", "pipe"] });
+  let out = "", err = "";
+  viewer.stdout.on("data", (d) => { out += d; });
+  viewer.stderr.on("data", (d) => { err += d; });
+  const ended = new Promise((r) => viewer.on("exit", (code) => r(code)));
+  try {
+    let url = null;
+    for (let i = 0; i < 100 && !url; i++) { const m = out.match(/at (http:\/\/\S+)/); if (m) url = m[1]; else await sleep(100); }
+    if (!check(url !== null && /replaying .* \(11 frames\)/.test(out), `swirl view RUN_DIR prints its address (${out.trim().split("\n")[0]})`))
+      throw new Error(`no URL; stderr: ${err}`);
+    browser = await puppeteer.launch({ executablePath: chromiumPath, headless: true, args: chromiumArgs,
+      defaultViewport: { width: 800, height: 600 } });
+    const page = await browser.newPage();
+    const errors = [];
+    page.on("pageerror", (e) => errors.push(String(e)));
+    await page.goto(url, { waitUntil: "load" });
+    const view = (f, ...a) => page.evaluate(f, ...a);
+    const waitFor = (f, what, timeout = 15_000, ...a) =>
+      page.waitForFunction(f, { timeout, polling: 50 }, ...a).catch(() => { throw new Error(`timed out: ${what}`); });
+    await waitFor(() => window.swirlView.received >= 1 && window.swirlView.status && window.swirlView.frames >= 5, "the first frame");
+    const ui = await view(() => ({ mode: window.swirlView.mode, bar: getComputedStyle(document.getElementById("replay")).display,
+      push: getComputedStyle(document.getElementById("pushlabel")).display,
+      step: getComputedStyle(document.getElementById("step")).display, max: document.getElementById("slider").max,
+      frame: window.swirlView.step }));
+    check(ui.mode === "replay" && ui.bar !== "none" && ui.push === "none" && ui.step === "none" && ui.max === "10" && ui.frame === 0,
+      `replay mode: the slider over 11 frames shown, the push and step hidden, frame 0 first (${JSON.stringify(ui)})`);
+    const meanZ = () => view(() => { const v = window.swirlView; let s = 0;
+      for (let i = 2; i < v.positions.length; i += 3) s += v.positions[i];
+      return { z: v.lo[2] + (s / v.count / 65535) * (v.hi[2] - v.lo[2]), step: v.step }; });
+    const z0 = await meanZ();
+    // A click on the slider, 70 % along: the frame under the pointer.
+    const box = await (await page.$("#slider")).boundingBox();
+    await page.mouse.click(box.x + 0.7 * box.width, box.y + box.height / 2);
+    const asked = Number(await view(() => document.getElementById("slider").value));
+    await waitFor((k) => window.swirlView.step === k && window.swirlView.status.frame === k, `frame ${asked}`, 10_000, asked);
+    const zk = await meanZ();
+    check(asked >= 5 && asked <= 9 && z0.z - zk.z > 0.005,
+      `the slider at frame ${asked}: that frame is shown, the column has fallen (mean z ${(1000 * z0.z).toFixed(1)} -> ${(1000 * zk.z).toFixed(1)} mm)`);
+    await page.click("#next");
+    await waitFor((k) => window.swirlView.step === k + 1, "the next frame", 10_000, asked);
+    const next = await view(() => window.swirlView.step);
+    await page.click("#prev"); await page.click("#prev");
+    await waitFor((k) => window.swirlView.step === k - 1, "two frames back", 10_000, asked);
+    const back = await view(() => ({ step: window.swirlView.step, slider: Number(document.getElementById("slider").value) }));
+    check(next === asked + 1 && back.step === asked - 1 && back.slider === asked - 1,
+      `next and previous step one frame (${asked} -> ${next} -> ${back.step}, the slider at ${back.slider})`);
+    await page.click("#play");
+    await waitFor(() => window.swirlView.step === 10 && window.swirlView.status.at_end, "the last frame", 15_000);
+    const end = await view(() => ({ slider: document.getElementById("slider").value, paused: window.swirlView.paused }));
+    check(end.slider === "10" && end.paused, `play reaches the last frame and stops there (${JSON.stringify(end)})`);
+    const png = await page.screenshot({ type: "png", clip: { x: 0, y: 0, width: 800, height: 600 } });
+    if (outDir) fs.writeFileSync(path.join(outDir, "replay.png"), png);
+    const drawn = await view(async (b64) => {
+      const img = new Image(); img.src = "data:image/png;base64," + b64; await img.decode();
+      const c = new OffscreenCanvas(img.width, img.height), g = c.getContext("2d"); g.drawImage(img, 0, 0);
+      const d = g.getImageData(0, 0, img.width, img.height).data; let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - 15) + Math.abs(d[i + 1] - 20) + Math.abs(d[i + 2] - 26) > 24) n++;
+      return n / (d.length / 4);
+    }, Buffer.from(png).toString("base64"));
+    check(drawn > 0.01, `replay screenshot: ${(100 * drawn).toFixed(1)} % of pixels drawn`);
+    check(errors.length === 0, `no script errors on the replay page${errors.length ? ": " + errors.join("; ") : ""}`);
+  } finally {
+    if (browser) await browser.close().catch(() => {});
+    browser = null;
+    viewer.kill("SIGINT");
+    const code = await ended;
+    check(code === 0, `swirl view RUN_DIR ends cleanly (exit ${code}): ${(out.match(/\d+ frames shown.*/) || [""])[0]}`);
+  }
+}
+try {
+  await replay();
+} catch (e) {
+  check(false, String(e && e.stack || e));
+}
+fs.rmSync(runDir, { recursive: true, force: true });
 clearTimeout(watchdog);
 log(failures ? `${failures} check(s) failed` : "all checks passed");
 process.exit(failures ? 1 : 0);

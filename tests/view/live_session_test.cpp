@@ -9,7 +9,10 @@
 
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <future>
+#include <mutex>
+#include <vector>
 #include <string>
 #include <thread>
 #include <utility>
@@ -21,74 +24,13 @@
 #include "swirl/scene/load.hpp"
 #include "swirl/view/live_run.hpp"
 #include "swirl/view/push_force.hpp"
+#include "view/ws_client.hpp"
 
 namespace swirl::view {
 namespace {
 
-namespace beast = boost::beast;
-namespace websocket = beast::websocket;
-namespace net = boost::asio;
-using tcp = net::ip::tcp;
 using namespace std::chrono_literals;
-
-// A viewer: one WebSocket, each read with a deadline (a test fails, never hangs).
-class Viewer {
- public:
-  explicit Viewer(std::uint16_t port) : ws_(ioc_) {
-    tcp::resolver resolver(ioc_);
-    beast::get_lowest_layer(ws_).connect(resolver.resolve("127.0.0.1", std::to_string(port)));
-    ws_.handshake("127.0.0.1", "/ws");
-  }
-  // The next message: text (first) and its bytes; throws after 20 s.
-  std::pair<bool, std::string> next() {
-    beast::flat_buffer buffer;
-    beast::error_code result = net::error::timed_out;
-    bool done = false;
-    ws_.async_read(buffer, [&](beast::error_code ec, std::size_t) { result = ec, done = true; });
-    ioc_.restart();
-    ioc_.run_for(20s);
-    if (!done) {
-      beast::get_lowest_layer(ws_).cancel();
-      ioc_.restart();
-      ioc_.run();
-      throw std::runtime_error("no message from the server within 20 s");
-    }
-    if (result) throw beast::system_error(result);
-    return {ws_.got_text(), beast::buffers_to_string(buffer.data())};
-  }
-  // The next frame, skipping text messages.
-  DecodedFrame frame() {
-    for (;;) {
-      auto [text, data] = next();
-      if (!text) return decode_frame({reinterpret_cast<const std::uint8_t*>(data.data()), data.size()});
-    }
-  }
-  // The next status message's text.
-  std::string status() {
-    for (;;) {
-      auto [text, data] = next();
-      if (text && data.find("\"status\"") != std::string::npos) return data;
-    }
-  }
-  void send(const std::string& bytes, bool text = false) {
-    ws_.text(text);
-    ws_.write(net::buffer(bytes));
-  }
-  // Reads until the server closes the session (true) or 20 s pass (false).
-  bool closed_by_server() {
-    try {
-      for (;;) next();
-    } catch (const beast::system_error&) {
-      return true;
-    } catch (const std::runtime_error&) {
-      return false;
-    }
-  }
-
- private:
-  net::io_context ioc_;
-  websocket::stream<beast::tcp_stream> ws_;
-};
+using test::Viewer;
 
 std::uint64_t field_u64(const std::string& json, const std::string& key) {
   const auto at = json.find("\"" + key + "\":");
@@ -108,7 +50,10 @@ class LiveSession : public ::testing::Test {
     options_.threads = 1;
     options_.start_paused = paused;
     options_.stop = &stop_;
-    options_.log = [](const std::string&) {};
+    options_.log = [this](const std::string& line) {
+      std::lock_guard lock(log_mutex_);
+      log_.push_back(line);
+    };
     std::promise<std::uint16_t> listening;
     auto port = listening.get_future();
     options_.on_listening = [&listening](const LiveServer& s) { listening.set_value(s.port()); };
@@ -123,8 +68,15 @@ class LiveSession : public ::testing::Test {
     if (run_.valid()) finish();
   }
 
+  std::vector<std::string> log() {
+    std::lock_guard lock(log_mutex_);
+    return log_;
+  }
+
   scene::Scene scene_;
   ViewOptions options_;
+  std::mutex log_mutex_;
+  std::vector<std::string> log_;
   std::atomic<bool> stop_{false};
   std::future<ViewResult> run_;
   std::uint16_t port_ = 0;
@@ -211,6 +163,116 @@ TEST_F(LiveSession, TheMousePushMovesTheFluid) {
   ASSERT_EQ(after.step, before.step + kSteps);
   // Measured: +3.0 mm with the push; without it (on = false) 0.00 mm.
   EXPECT_GT(mean_y(after) - y0, 0.0005f) << "the push along +y should move the fluid's mean y";
+}
+
+float mean_z(const DecodedFrame& f) {
+  double sum = 0;
+  for (const float z : f.z) sum += z;
+  return float(sum / double(f.z.size()));
+}
+
+// The sliders' parameters: the hello offers the dam break's viscosity and
+// gravity (not the softening: no [nbody]) with the scene's values and ranges;
+// a new value reaches the solver between steps (the status reads it back from
+// the solver; gravity turned upward lifts the fluid instead of letting it
+// fall) and is logged with its step; values outside the range, and a
+// parameter the run does not have, are refused and change nothing.
+TEST_F(LiveSession, ParameterChangesReachTheSimulationAndOutOfRangeOnesAreRefused) {
+  start(/*paused=*/true);
+  Viewer v(port_);
+  auto [text, hello] = v.next();
+  ASSERT_TRUE(text);
+  EXPECT_NE(hello.find(R"({"id":0,"key":"sph.viscosity","label":"viscosity","unit":"Pa·s","vector":false,"min":0,"max":5,)"),
+            std::string::npos) << hello;  // the dam break's 0.5 Pa·s: 10 x 0.5 at most
+  EXPECT_NE(hello.find(R"("key":"forces.gravity")"), std::string::npos) << hello;
+  EXPECT_EQ(hello.find("nbody.softening"), std::string::npos) << hello;
+  EXPECT_DOUBLE_EQ(test::json_number_at(test::next_text(v, "status"), "sph.viscosity"), 0.5);
+
+  using control::Parameter, control::ParameterId;
+  v.send(encode_control(Parameter{ParameterId::Viscosity, {1.5f, 0, 0}}));
+  std::string st = test::next_text(v, "status");
+  for (int k = 0; k < 20 && test::json_number_at(st, "sph.viscosity") != 1.5; ++k) st = test::next_text(v, "status");
+  EXPECT_DOUBLE_EQ(test::json_number_at(st, "sph.viscosity"), 1.5) << st;
+
+  // Refused: below the key's range (>= 0), above the view's bound, a parameter the scene lacks.
+  v.send(encode_control(Parameter{ParameterId::Viscosity, {-0.1f, 0, 0}}));
+  EXPECT_NE(test::next_text(v, "refused").find("sph.viscosity = -0.1 Pa·s is outside [0, 5]"), std::string::npos);
+  v.send(encode_control(Parameter{ParameterId::Viscosity, {6, 0, 0}}));
+  EXPECT_NE(test::next_text(v, "refused").find("outside"), std::string::npos);
+  v.send(encode_control(Parameter{ParameterId::Gravity, {0, 0, -100}}));  // |g| over 4 x 9.81
+  EXPECT_NE(test::next_text(v, "refused").find("forces.gravity magnitude = 100"), std::string::npos);
+  v.send(encode_control(Parameter{ParameterId::Softening, {0.01f, 0, 0}}));
+  EXPECT_NE(test::next_text(v, "refused").find("no parameter 2"), std::string::npos);
+  st = test::next_text(v, "status");
+  EXPECT_DOUBLE_EQ(test::json_number_at(st, "sph.viscosity"), 1.5) << "a refused value changes nothing: " << st;
+
+  // Gravity upward: 50 steps (0.02 s) lift the column's mean z, where it would fall.
+  v.send(encode_control(control::Step{}));  // a frame to start from (the first was skipped over above)
+  const DecodedFrame before = v.frame();
+  v.send(encode_control(Parameter{ParameterId::Gravity, {0, 0, 9.81f}}));
+  constexpr int kSteps = 50;
+  for (int k = 0; k < kSteps; ++k) v.send(encode_control(control::Step{}));
+  DecodedFrame after = v.frame();
+  for (int k = 0; k < 10 * kSteps && after.step < before.step + kSteps; ++k) after = v.frame();
+  ASSERT_EQ(after.step, before.step + kSteps);
+  EXPECT_GT(mean_z(after) - mean_z(before), 0.0005f) << "g = +9.81 z should lift the fluid";
+
+  const ViewResult r = finish();
+  EXPECT_EQ(r.parameter_changes, 2u);
+  EXPECT_EQ(r.refused, 4u);
+  int logged = 0;
+  for (const auto& line : log())
+    if (line.find("sph.viscosity 0.5 Pa·s -> 1.5 Pa·s") != std::string::npos ||
+        line.find("forces.gravity (0, 0, -9.81) m/s² -> (0, 0, 9.81) m/s²") != std::string::npos)
+      ++logged;
+  EXPECT_EQ(logged, 2) << "each change is logged with its step";
+}
+
+// A gravity run offers the softening (only): a larger ε reaches the tree
+// walk, whose potential energy |W| then drops, where one step without the
+// change leaves it as it was.
+TEST(LiveSessionGravity, TheSofteningSliderReachesTheTreeWalk) {
+  const scene::Scene scene = scene::load_scene(std::string(SWIRL_SOURCE_DIR) + "/examples/plummer.toml",
+                                               std::vector<std::string>{"particles.0.count=400"});
+  std::atomic<bool> stop{false};
+  ViewOptions options;
+  options.threads = 1;
+  options.start_paused = true;
+  options.stop = &stop;
+  std::promise<std::uint16_t> listening;
+  auto port = listening.get_future();
+  options.on_listening = [&listening](const LiveServer& s) { listening.set_value(s.port()); };
+  auto run = std::async(std::launch::async, [&] { return view_scene(scene, options); });
+  {
+    Viewer v(port.get());
+    auto [text, hello] = v.next();
+    EXPECT_NE(hello.find(R"("key":"nbody.softening")"), std::string::npos) << hello;
+    EXPECT_EQ(hello.find("sph.viscosity"), std::string::npos) << hello;
+    EXPECT_EQ(hello.find("forces.gravity"), std::string::npos) << "no uniform field in a Plummer sphere: " << hello;
+    auto step = [&] {  // one step; its status
+      const std::uint64_t s0 = field_u64(test::next_text(v, "status"), "step");
+      v.send(encode_control(control::Step{}));
+      std::string st = test::next_text(v, "status");
+      for (int k = 0; k < 20 && field_u64(st, "step") <= s0; ++k) st = test::next_text(v, "status");
+      return st;
+    };
+    const std::string a = step(), b = step();
+    EXPECT_DOUBLE_EQ(test::json_number_at(b, "nbody.softening"), 0.01);
+    v.send(encode_control(control::Parameter{control::ParameterId::Softening, {0.5f, 0, 0}}));
+    const std::string c = step();
+    EXPECT_DOUBLE_EQ(test::json_number_at(c, "nbody.softening"), 0.5) << c;
+    const double w_a = test::json_number_at(a, "potential_energy"), w_b = test::json_number_at(b, "potential_energy"),
+                 w_c = test::json_number_at(c, "potential_energy");
+    EXPECT_LT(w_a, 0);
+    EXPECT_LT(std::abs(w_b - w_a), 0.01 * std::abs(w_a)) << "one step alone";
+    EXPECT_GT(w_c - w_b, 0.1 * std::abs(w_b)) << "ε = 0.5 makes the potential much shallower";
+    v.send(encode_control(control::Parameter{control::ParameterId::Softening, {-0.01f, 0, 0}}));
+    EXPECT_NE(test::next_text(v, "refused").find("nbody.softening"), std::string::npos);
+  }
+  stop = true;
+  const ViewResult r = run.get();
+  EXPECT_EQ(r.parameter_changes, 1u);
+  EXPECT_EQ(r.refused, 1u);
 }
 
 TEST(PushForce, RelaxesVelocitiesTowardTheDragWithinItsRadiusOnly) {

@@ -75,7 +75,8 @@ TEST(Wire, ControlsRoundTrip) {
   push.on = true;
   for (const Control& c : {Control{control::Pause{}}, Control{control::Resume{}}, Control{control::Step{}},
                            Control{control::Reset{}}, Control{control::Speed{60}}, Control{control::Colour{4}},
-                           Control{push}}) {
+                           Control{push}, Control{control::Seek{70000}},
+                           Control{control::Parameter{control::ParameterId::Gravity, {1, 0, -9.81f}}}}) {
     const Parsed p = parse_control(bytes(encode_control(c)));
     ASSERT_TRUE(p.control) << p.error;
     EXPECT_EQ(p.control->index(), c.index());
@@ -86,6 +87,11 @@ TEST(Wire, ControlsRoundTrip) {
   EXPECT_EQ(back.velocity.z, -0.5f);
   EXPECT_EQ(back.radius, 0.1f);
   EXPECT_TRUE(back.on);
+  EXPECT_EQ(std::get<control::Seek>(*parse_control(bytes(encode_control(control::Seek{70000}))).control).frame, 70000u);
+  const auto g = std::get<control::Parameter>(
+      *parse_control(bytes(encode_control(control::Parameter{control::ParameterId::Gravity, {1, 0, -9.81f}}))).control);
+  EXPECT_EQ(g.id, control::ParameterId::Gravity);
+  EXPECT_EQ(g.value.z, -9.81f);
 }
 
 TEST(Wire, MalformedControlsAreRefusedWithAReason) {
@@ -99,6 +105,11 @@ TEST(Wire, MalformedControlsAreRefusedWithAReason) {
   push.radius = 0;
   const std::string zero_radius = encode_control(push);
   const std::string negative_speed = encode_control(control::Speed{-1});
+  std::string unknown_parameter = encode_control(control::Parameter{control::ParameterId::Viscosity, {1, 0, 0}});
+  unknown_parameter[1] = 3;
+  std::string nan_parameter = encode_control(control::Parameter{control::ParameterId::Softening, {0, 0, 0}});
+  std::memcpy(nan_parameter.data() + 2, &nan, 4);
+  const std::string scalar_with_y = encode_control(control::Parameter{control::ParameterId::Viscosity, {1, 2, 0}});
   for (const auto& [message, reason] : std::vector<std::pair<std::string, std::string>>{
            {"", "empty"},
            {std::string(1, '\0'), "unknown control kind 0"},
@@ -110,6 +121,10 @@ TEST(Wire, MalformedControlsAreRefusedWithAReason) {
            {bad_on, "'on' must be 0 or 1"},
            {zero_radius, "radius must be > 0"},
            {negative_speed, "must be finite and >= 0"},
+           {std::string(3, char(8)), "control kind 8 has 3 bytes, expected 5"},
+           {unknown_parameter, "unknown parameter 3"},
+           {nan_parameter, "parameter: a value is not finite"},
+           {scalar_with_y, "y and z must be 0"},
        }) {
     const Parsed p = parse_control(bytes(message));
     EXPECT_FALSE(p.control) << reason;

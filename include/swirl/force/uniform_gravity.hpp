@@ -57,6 +57,8 @@ class UniformGravity final : public Solver<Real> {
   }
 
   const Vec3<Real>& g() const { return g_; }
+  // A new field from the next evaluation on (swirl view's slider), between steps.
+  void set_g(const Vec3<Real>& g) { g_ = g; }
 
  private:
   Vec3<Real> g_;

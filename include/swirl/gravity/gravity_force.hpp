@@ -77,6 +77,9 @@ class GravityForce final : public Solver<Real> {
 
   const GravitySettings& settings() const { return settings_; }
   const SelfGravityOptions& options() const { return options_; }
+  // A new softening ε (finite, ≥ 0) from the next evaluation on (swirl view's
+  // slider; call Simulation::parameters_changed() after it, between steps).
+  void set_softening(double softening);
   // The last evaluation: nodes visited per particle (N − 1 for the direct sum), trees, times.
   const GravityStats& stats() const { return stats_; }
   // The last evaluation's field, in G = 1 units.

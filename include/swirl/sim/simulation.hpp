@@ -148,6 +148,17 @@ class Simulation {
     started_ = true;
   }
 
+  // A solver's parameter was changed between steps (swirl view's sliders:
+  // SphFluid::set_viscosity, ...): finds again what the step's scan gathers
+  // (a viscosity turned on needs the density extremes) and the limits of the
+  // current state, so that the next Δt and the guard follow the new value.
+  void parameters_changed() {
+    if (!prepared_) return;
+    needs_ = {};
+    for (auto& s : solvers_) needs_ |= s->scan_needs();
+    if (started_) rescan();
+  }
+
   // Continues from a restored state instead of start(): particles() holds
   // every field as it was after clock.step (a checkpoint), `state` what
   // save_state() wrote then; the next step() is the one the original run took.

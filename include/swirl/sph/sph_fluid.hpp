@@ -294,6 +294,12 @@ class SphFluid final : public Solver<Real> {
   const spatial::SpatialHash<Real>& hash() const { return hash_; }
   const spatial::SortedCellGrid<Real>& grid() const { return grid_; }
   const SphParameters& parameters() const { return params_; }
+  // A new viscosity μ (≥ 0) from the next evaluation on (swirl view's slider;
+  // call Simulation::parameters_changed() after it, between steps).
+  void set_viscosity(double mu) {
+    if (!(mu >= 0) || !std::isfinite(mu)) throw std::invalid_argument("SPH: viscosity must be finite and ≥ 0");
+    params_.viscosity = mu;
+  }
   // True when the last evaluation used the sorted grid.
   bool used_grid() const { return used_grid_; }
   const StepConditions& conditions() const { return conditions_; }

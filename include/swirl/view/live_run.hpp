@@ -9,9 +9,13 @@
 //
 // Controls from the page act between steps: pause, resume, one step, reset
 // (the scene built again from its start), a speed cap, the field that colours
-// the particles, and the mouse's push: an external force (PushForce, a solver
+// the particles, the mouse's push: an external force (PushForce, a solver
 // like any other) a = strength·(v_drag − v)·(1 − r/R) on the particles within
-// R of the point, which drags the fluid along with the pointer. A live run
+// R of the point, which drags the fluid along with the pointer, and the live
+// parameters (view/parameters.hpp: viscosity, gravity, softening), each change
+// checked against its key's range, applied to the solver on the simulation's
+// thread and logged with the step and time it took effect at; a reset rebuilds
+// the scene with the values changed so far. A live run
 // writes no run folder; a blow-up pauses it with the message shown on the page
 // (reset starts over). At the scene's end time it pauses.
 #pragma once
@@ -41,8 +45,12 @@ struct ViewOptions {
 struct ViewResult {
   std::uint64_t steps = 0;    // steps taken in the session (over resets)
   std::uint64_t resets = 0;
+  std::uint64_t parameter_changes = 0;  // live parameter values applied
+  std::uint64_t refused = 0;            // controls refused by the session (a value out of range, a seek past the end)
   double wall_seconds = 0;
-  double setup_seconds = 0;   // of which building the simulation before the first step
+  double setup_seconds = 0;   // of which building the simulation before the first step (replay: reading the first frame)
+  std::uint64_t frames_read = 0;  // replay: frame files read (steps: frames shown)
+  double read_seconds = 0;        // replay: time spent reading them
   ServerStats server;
 };
 

@@ -26,6 +26,13 @@
 //   6 colour  u8 field index
 //   7 push    f32 x, y, z (a point), f32 vx, vy, vz (the drag's velocity),
 //             f32 radius (> 0), f32 strength (≥ 0, 1/s), u8 on (0 or 1)
+//   8 seek    u32 frame index (replay: the frame to show)
+//   9 parameter  u8 which (0 viscosity, 1 gravity, 2 softening), f32 x, y, z:
+//             the new value (a scalar in x with y = z = 0; gravity's g as a
+//             vector). Whether the value lies in the parameter's range is the
+//             session's to check (view/parameters.hpp), not the wire's.
+// In a replay (`swirl view RUN_DIR`) a frame's step field holds the frame's
+// index in the run's series.
 #pragma once
 
 #include <array>
@@ -88,9 +95,19 @@ struct Push {
   float radius = 0, strength = 0;
   bool on = false;
 };
+struct Seek {
+  std::uint32_t frame = 0;
+};
+// The live parameters a page may change (view/parameters.hpp).
+enum class ParameterId : std::uint8_t { Viscosity = 0, Gravity = 1, Softening = 2 };
+inline constexpr std::uint8_t kParameterCount = 3;
+struct Parameter {
+  ParameterId id = ParameterId::Viscosity;
+  Vec3<float> value;  // a scalar parameter's value in x (y = z = 0)
+};
 }  // namespace control
 using Control = std::variant<control::Pause, control::Resume, control::Step, control::Reset, control::Speed,
-                             control::Colour, control::Push>;
+                             control::Colour, control::Push, control::Seek, control::Parameter>;
 
 // A control message, or why it is not one (kind, length or value).
 struct Parsed {
