@@ -312,16 +312,22 @@ void run_checked(Simulation<double>& sim, double end, Check&& check) {
 }
 
 TEST(BoundaryObstacles, NoFluidParticleCrossesAThinPlate) {
-  // A dam break (0.15 m wide, 0.25 m high, spacing 0.02) against a plate of no
-  // thickness across the whole tank at x = 0.25: a sheet of boundary particles.
+  // A dam break (0.15 m wide, 0.25 m high, spacing 0.02) against a plate
+  // across the whole tank at x = 0.25. DFSPH: a plate of no thickness, one
+  // sheet of boundary particles. The thesis's solver: a plate one spacing
+  // thick (two sheets). A single sheet's normal push vanishes in its plane,
+  // and the weakly compressible fluid can squeeze a particle into it and
+  // through: seen at t = 0.50 s in the -O1 (ASan) build, whose rounding
+  // differs, while the release build kept every particle out (docs/sph.md).
   for (const char* method : {"dfsph", "wcsph"}) {
-    const double dt = std::string(method) == "dfsph" ? 0.004 : 4e-4;
+    const bool dfsph = std::string(method) == "dfsph";
+    const double dt = dfsph ? 0.004 : 4e-4;
+    const std::string plate = dfsph ? "max = [0.25, 0.1, 0.4]" : "max = [0.27, 0.1, 0.4]";
     Simulation<double> sim = build(adaptive(tank_scene(0.5, 0.1, 0.4, 0.15, 0.25, 0.02, dt, method, "", R"(
 [[particles]]
 kind = "obstacle_box"
 min = [0.25, 0.0, 0.0]
-max = [0.25, 0.1, 0.4]
-)"), dt));
+)" + plate + "\n"), dt));
     double furthest = 0;
     run_checked(sim, 0.6, [&](const ParticleSet<double>& p, int k) {
       for (std::size_t i = 0; i < p.size(); ++i) {
