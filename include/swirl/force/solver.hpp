@@ -43,6 +43,11 @@
 
 namespace swirl {
 
+namespace dist {
+template <class Real>
+class RankOrder;
+}  // namespace dist
+
 // What a solver may know about the evaluation it is called in.
 template <class Real>
 struct SolverContext {
@@ -51,6 +56,10 @@ struct SolverContext {
   PhaseTimers* timers = nullptr;                        // where a solver may time its sub-phases
   const spatial::ParticleOrder<Real>* order = nullptr;  // the particle order, current for these positions
   ActiveSet active;  // the particles to compute (block time steps); others' acceleration may be left as is
+  // On several ranks (dist/rank_order.hpp): the global order this rank's
+  // particles are a range of (order is then null). A solver that does not run
+  // on ranks throws std::invalid_argument; the run refuses such scenes first.
+  const dist::RankOrder<Real>* ranks = nullptr;
 };
 
 // A limit's words for the guard: the rule with its numbers, and the change that relaxes it.
@@ -120,7 +129,7 @@ void evaluate_alone(Solver<Real>& solver, ParticleSet<Real>& particles, spatial:
   solver.declare_fields(particles);
   order.set_request(solver.order_request());
   order.update(particles, block_size);
-  solver.add_acceleration(particles, SolverContext<Real>{time, block_size, timers, order.active() ? &order : nullptr, {}});
+  solver.add_acceleration(particles, SolverContext<Real>{time, block_size, timers, order.active() ? &order : nullptr, {}, nullptr});
 }
 
 // The same with an order made for this one call (no skin carried over).
