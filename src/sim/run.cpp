@@ -806,7 +806,11 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
 // What of a scene (built: its particles) does not run on several ranks yet.
 template <class Real>
 std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<Real>& particles) {
-  if (scene.nbody) return "self-gravity ([nbody])";
+  if (scene.nbody) {
+    if (scene.time_steps == scene::TimeSteps::Block) return "simulation.time_steps = \"block\"";
+    const std::string no = gravity::GravityForce<Real>(*scene.nbody).distributed_support();
+    if (!no.empty()) return "self-gravity with " + no;
+  }
   if (scene.sph) {
     const std::string no = sph::SphFluid<Real>(*scene.sph).distributed_support();
     if (!no.empty()) return no;

@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # `swirl run` on several MPI ranks (issue 19, points 1, 5, 6 and 7): the same
-# scene on 1 (no mpirun), 2, 3 and 4 ranks gives byte-identical frames,
+# scene (SPH, self-gravity, both) on 1 (no mpirun), 2, 3 and 4 ranks gives byte-identical frames,
 # diagnostics and checkpoints; a run resumes on another rank count and ends
 # with the one-rank bytes; a blow-up stops every rank with the one-rank
 # message and keeps the frames; a scene part that is not distributed yet is
 # refused once with status 2 and leaves no folder; more ranks than particles
 # are refused.
 #
-#   run_on_ranks.sh MPIEXEC SWIRL SCENE      (SCENE: examples/dam_break.toml)
+#   run_on_ranks.sh MPIEXEC SWIRL EXAMPLES   (EXAMPLES: the examples/ folder)
 set -uo pipefail
-mpiexec=$1 swirl=$2 scene=$3
+mpiexec=$1 swirl=$2 examples=$3
+scene=$examples/dam_break.toml
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 failures=0
@@ -72,7 +73,26 @@ for pair in "2 3" "4 1"; do
   done
 done
 
-# 4. A blow-up (a step far beyond the CFL limit) on 3 ranks: status 1, the
+# 4. Self-gravity (the locally essential tree): a Plummer sphere of 2 000
+#    stars, 12 steps, on 2 and 4 ranks against one; then SPH with self-gravity,
+#    drag and adaptive steps (a self-gravitating drop of 1 500 particles) on 3.
+grav=("$examples/plummer.toml" --set particles.0.count=2000 --set output.interval=0.0625 --steps 12
+      --checkpoint-every-steps 6)
+on_ranks 1 run "${grav[@]}" --out "$out/gravity_1"
+[ "$status" -eq 0 ] || { fail "gravity on 1 rank: status $status"; cat "$out/stderr"; }
+for n in 2 4; do
+  on_ranks "$n" run "${grav[@]}" --out "$out/gravity_$n"
+  [ "$status" -eq 0 ] || { fail "gravity on $n ranks: status $status"; cat "$out/stderr"; }
+  same_files "$out/gravity_1" "$out/gravity_$n" "gravity on $n ranks"
+done
+drop=("$examples/self_gravitating_drop.toml" --set particles.0.count=1500 --until 0.1 --set output.interval=0.025)
+on_ranks 1 run "${drop[@]}" --out "$out/drop_1"
+[ "$status" -eq 0 ] || { fail "drop on 1 rank: status $status"; cat "$out/stderr"; }
+on_ranks 3 run "${drop[@]}" --out "$out/drop_3"
+[ "$status" -eq 0 ] || { fail "drop on 3 ranks: status $status"; cat "$out/stderr"; }
+same_files "$out/drop_1" "$out/drop_3" "SPH with self-gravity on 3 ranks"
+
+# 5. A blow-up (a step far beyond the CFL limit) on 3 ranks: status 1, the
 #    one-rank message exactly, printed once; frame 0 kept.
 big=("${small[@]}" --set simulation.dt=0.01)
 on_ranks 1 run "$scene" "${big[@]}" --steps 20 --out "$out/blow_1"
@@ -86,21 +106,24 @@ cmp -s "$out/blow_1.txt" "$out/blow_3.txt" || { fail "blow-up on 3 ranks: not th
 cmp -s "$out/blow_1/particles_000000.vtp" "$out/blow_3/particles_000000.vtp" || fail "blow-up on 3 ranks: frame 0 lost or changed"
 head -c 400 "$out/blow_3.txt"; echo
 
-# 5. What is not distributed yet is refused once, with status 2, before any folder.
+# 6. What is not distributed yet is refused once, with status 2, before any folder.
 on_ranks 2 run "$scene" "${small[@]}" --set 'sph.method="dfsph"' --steps 2 --out "$out/refused"
 [ "$status" -eq 2 ] || fail "dfsph on 2 ranks: status $status (want 2)"
 [ "$(grep -c 'does not run on several MPI ranks yet' "$out/stderr")" -eq 1 ] ||
   fail "dfsph on 2 ranks: the refusal is not printed exactly once"
 [ ! -e "$out/refused" ] || fail "dfsph on 2 ranks: the refused run created its folder"
 cat "$out/stderr"
+on_ranks 2 run "$examples/plummer.toml" --set 'nbody.method="fmm"' --steps 2 --out "$out/refused"
+[ "$status" -eq 2 ] || fail "the FMM on 2 ranks: status $status (want 2)"
+grep -q 'nbody.method = "fmm" does not run on several MPI ranks yet' "$out/stderr" || fail "the FMM on 2 ranks: not said why"
 
-# 6. The folder's lock and files are rank 0's: a second run into a folder
+# 7. The folder's lock and files are rank 0's: a second run into a folder
 #    holding another run is refused on every rank with status 2.
 on_ranks 2 run "$scene" "${small[@]}" --steps 2 --out "$out/float_1"
 [ "$status" -eq 2 ] || fail "a run into another run's folder on 2 ranks: status $status (want 2)"
 grep -q "swirl: error" "$out/stderr" || fail "a run into another run's folder: no error message"
 
-# 7. More ranks than particles: said before anything runs, status 2.
+# 8. More ranks than particles: said before anything runs, status 2.
 on_ranks 4 run "$scene" --set particles.0.spacing=0.29 --steps 2 --out "$out/few"
 [ "$status" -eq 2 ] || fail "1 particle on 4 ranks: status $status (want 2)"
 grep -q "1 particles on 4 MPI ranks: every rank needs at least one particle" "$out/stderr" ||

@@ -14,7 +14,9 @@
 //      unit of cost per particle), then distribute_in_key_order(): every
 //      particle moves to the rank whose key range holds it, each rank's
 //      particles sorted by (key, previous global index), which is the one-rank
-//      stable sort whatever the rank count.
+//      stable sort whatever the rank count; a cut rule (set_cut_rule: the
+//      solvers' Solver::rank_cuts) may move the cuts first, e.g. onto the
+//      gravity tree's group boundaries.
 // So keys(), frame() and the particles' order are the one-rank ones, cut into
 // ranges; where the cuts fall changes no result (the halo's invariants,
 // dist/halo.hpp), only the balance. The cuts are recomputed at every sort:
@@ -37,6 +39,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <span>
 #include <stdexcept>
@@ -67,6 +70,12 @@ class RankOrder {
   }
   const spatial::OrderRequest& request() const { return request_; }
   bool active() const { return request_.sorted; }
+
+  // Moves the balanced cuts where the solvers need them (collective: every
+  // rank gets this rank's keys and the same cuts, returns the same cuts).
+  using CutRule = std::function<std::vector<std::uint64_t>(std::span<const std::uint64_t> keys,
+                                                           std::vector<std::uint64_t> cuts)>;
+  void set_cut_rule(CutRule rule) { cut_rule_ = std::move(rule); }
 
   // p holds every particle, the same on every rank, in the one-rank memory
   // order (a scene's initial state, or a checkpoint's when resumed): keeps
@@ -125,6 +134,7 @@ class RankOrder {
     cells_fit_ = fits;
     keys_ = keys_in_frame(frame_, p);
     cut_keys_ = balanced_cut_keys(*comm_, keys_, std::vector<std::uint64_t>(keys_.size(), 1));
+    if (cut_rule_) cut_keys_ = cut_rule_(keys_, std::move(cut_keys_));
     const Distribution d = distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_);
     first_ = d.first_global_index;
     global_count_ = d.global_count;
@@ -177,6 +187,7 @@ class RankOrder {
 
   const Communicator* comm_;
   spatial::OrderRequest request_;
+  CutRule cut_rule_;
   spatial::KeyFrame frame_;
   bool cells_fit_ = true;
   bool valid_ = false;

@@ -30,6 +30,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,6 +39,7 @@
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/phase_timers.hpp"
+#include "swirl/dist/communicator.hpp"
 #include "swirl/force/step_scan.hpp"
 #include "swirl/spatial/particle_order.hpp"
 
@@ -86,6 +88,16 @@ class Solver {
 
   // Adds this solver's acceleration into particles.acceleration (see the header).
   virtual void add_acceleration(ParticleSet<Real>& particles, const SolverContext<Real>& ctx) = 0;
+
+  // On several ranks: where the ranks' key ranges may end. Given this rank's
+  // keys (dist::RankOrder's, this evaluation's) and cuts balanced by count,
+  // returns the cuts this solver's passes need (self-gravity: on group
+  // boundaries of the global tree). Collective; the same cuts on every rank.
+  virtual std::vector<std::uint64_t> rank_cuts(const dist::Communicator& /*comm*/,
+                                               std::span<const std::uint64_t> /*keys*/,
+                                               std::vector<std::uint64_t> cuts) const {
+    return cuts;
+  }
 
   // Time-step conditions.
   virtual ScanNeeds scan_needs() const { return {}; }

@@ -178,7 +178,13 @@ class Simulation {
       needs_ |= s->scan_needs();
     }
     order_.set_request(request);
-    if (ranks_) ranks_->set_request(request);
+    if (ranks_) {
+      ranks_->set_request(request);
+      ranks_->set_cut_rule([this](std::span<const std::uint64_t> keys, std::vector<std::uint64_t> cuts) {
+        for (const auto& s : solvers_) cuts = s->rank_cuts(ranks_->comm(), keys, std::move(cuts));
+        return cuts;
+      });
+    }
     if (request.keep_within > 0) particles_.add_field(std::string(spatial::ParticleOrder<Real>::kReferenceField), 3, FieldUse::Internal);
     prepared_ = true;
   }
