@@ -4,6 +4,10 @@
 //             [--checkpoint-every T] [--checkpoint-every-steps N] [--checkpoint-keep K]
 //   swirl run --resume RUN_DIR [--steps N | --until T] [--threads N] [checkpoint options]
 //   --render-every K: also draw every K-th frame to OUT/render/ (render_command.cpp, swirl/render)
+//
+// Under mpirun every rank runs its share (sim/run.hpp, RunOptions::ranks);
+// rank 0 prints and writes. Bad input is found alike on every rank and ends
+// them all with status 2 (as a scene error: run_cli.cpp prints it once).
 #include <unistd.h>
 
 #include <algorithm>
@@ -20,6 +24,7 @@
 #include "cli.hpp"
 #include "commands.hpp"
 #include "flags.hpp"
+#include "swirl/dist/communicator.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/run_folder.hpp"
 #include "swirl/scene/load.hpp"
@@ -86,8 +91,11 @@ void check_outputs(const RunArgs& args, const std::filesystem::path& out_dir) {
   }
 }
 
-int run(const RunArgs& args) {
+int run_here(const RunArgs& args) {
+  const dist::Communicator& comm = dist::Communicator::world();
+  const bool speak = comm.is_root();
   sim::RunOptions options;
+  if (comm.distributed()) options.ranks = &comm;
   scene::Scene scene;
   if (!args.resume.empty()) {
     if (!args.scene.empty() || !args.overrides.empty())
@@ -119,8 +127,8 @@ int run(const RunArgs& args) {
   options.checkpoint_keep = args.checkpoint_keep;
   options.overwrite = args.overwrite;
   options.on_blow_up = args.on_blowup == "warn" ? OnBlowUp::Warn : args.on_blowup == "off" ? OnBlowUp::Off : OnBlowUp::Stop;
-  options.on_warning = [](const std::string& w) {
-    fmt::print(stderr, "{}swirl run: warning: {}\n", ::isatty(STDERR_FILENO) ? "\n" : "", w);
+  options.on_warning = [speak](const std::string& w) {
+    if (speak) fmt::print(stderr, "{}swirl run: warning: {}\n", ::isatty(STDERR_FILENO) ? "\n" : "", w);
   };
   options.stop = &g_stop;
   if (args.render_every > 0) {
@@ -150,7 +158,13 @@ int run(const RunArgs& args) {
   std::signal(SIGTERM, on_signal);
 
   ProgressDisplay progress(stderr);
-  const auto summary = sim::run_scene(scene, options, [&](const auto& p) { progress.update(p); });
+  const auto summary = sim::run_scene(scene, options, [&](const auto& p) {
+    if (speak) progress.update(p);
+  });
+  if (!speak) {  // rank 0 reports; the others end with the same status
+    if (summary.interrupted) return 128 + g_signal.load();
+    return summary.error.empty() && summary.failed_checks.empty() ? 0 : 1;
+  }
   progress.finish();
   for (const auto& w : summary.warnings) fmt::print(stderr, "swirl run: warning: {}\n", w);
 
@@ -186,6 +200,18 @@ int run(const RunArgs& args) {
   return 0;
 }
 
+// On several ranks bad input (std::invalid_argument: a flag, a scene, a
+// folder) is found the same way on every rank: a scene error, which every
+// rank answers with status 2 and rank 0 prints, instead of one rank's failure.
+int run(const RunArgs& args) {
+  if (!dist::Communicator::world().distributed()) return run_here(args);
+  try {
+    return run_here(args);
+  } catch (const std::invalid_argument& e) {
+    throw scene::SceneError(e.what());
+  }
+}
+
 }  // namespace
 
 void add_run_command(CLI::App& app, Commands& commands) {
@@ -215,7 +241,7 @@ void add_run_command(CLI::App& app, Commands& commands) {
       ->check(CLI::IsMember({"stop", "warn", "off"}));
   run_cmd->add_option("--render-every", args->render_every, "Draw every K-th frame as a PNG in OUT/render (see swirl render)")
       ->check(whole_number(1, kMaxSteps));
-  commands.push_back({run_cmd, [args] { return run(*args); }});
+  commands.push_back({run_cmd, [args] { return run(*args); }, /*distributed=*/true});
 }
 
 }  // namespace swirl::cli

@@ -46,7 +46,7 @@ class GravityOnly final : public integrate::Forces {
                     Real(0));
       });
     }
-    gravity_.add_acceleration(p_, SolverContext<Real>{time, block_, &timers_, nullptr, {}});
+    gravity_.add_acceleration(p_, SolverContext<Real>{time, block_, &timers_, nullptr, {}, nullptr});
   }
 
  private:

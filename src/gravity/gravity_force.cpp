@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "swirl/dist/rank_order.hpp"
 #include "swirl/gravity/diagnostics.hpp"
 #include "swirl/gravity/direct_sum.hpp"
 #include "swirl/parallel/for_blocks.hpp"
@@ -51,6 +52,21 @@ bool GravityForce<Real>::views_order() const {
 }
 
 template <class Real>
+std::string GravityForce<Real>::distributed_support() const {
+  if (settings_.method != Method::BarnesHut) return fmt::format("nbody.method = \"{}\"", to_string(settings_.method));
+  if (!views_order()) return "a Barnes-Hut tree other than the linear octree over the particle order";
+  if (settings_.walk != Walk::Group) return "nbody.walk = \"particle\"";
+  return {};
+}
+
+template <class Real>
+std::vector<std::uint64_t> GravityForce<Real>::rank_cuts(const dist::Communicator& comm,
+                                                         std::span<const std::uint64_t> keys,
+                                                         std::vector<std::uint64_t> cuts) const {
+  return group_aligned_cuts(comm, keys, cuts, tree_.linear_settings());
+}
+
+template <class Real>
 void GravityForce<Real>::declare_fields(ParticleSet<Real>& p) {
   p.add_field("potential", 1);
 }
@@ -64,7 +80,34 @@ spatial::OrderRequest GravityForce<Real>::order_request() const {
 
 template <class Real>
 void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
-  if (settings_.method == Method::Direct) {
+  if (ctx.ranks) {
+    // The locally essential tree over the global order (essential_tree.hpp):
+    // every particle's field is the one-rank group walk's, bit for bit.
+    if (const std::string no = distributed_support(); !no.empty())
+      throw std::invalid_argument("self-gravity on several ranks: " + no + " does not run on several ranks yet");
+    if (!ctx.active.all())
+      throw std::invalid_argument("self-gravity on several ranks: block time steps do not run on several ranks yet");
+    const dist::RankOrder<Real>& order = *ctx.ranks;
+    const spatial::KeyFrame& f = order.frame();
+    const auto t0 = std::chrono::steady_clock::now();
+    essential_.build(order.comm(), p, order.keys(), order.first_global_index(), order.cut_keys(),
+                     KeyCube{f.corner, f.root_side()}, tree_.linear_settings(), ctx.block_size);
+    const auto t1 = std::chrono::steady_clock::now();
+    const WalkCounts counts = essential_.evaluate(field_);
+    // The one-rank figures: exact integer sums over ranks, then its divisions.
+    std::uint64_t sums[2] = {counts.nodes, counts.multipoles + counts.pairs};
+    order.comm().sum(sums);
+    const double n = double(order.global_count());
+    stats_ = GravityStats{};
+    stats_.walked = order.global_count();
+    stats_.trees = 1;
+    stats_.nodes = essential_.stats().tree_nodes;
+    stats_.tree_bytes = essential_.tree().bytes();
+    stats_.mean_nodes_visited = n > 0 ? double(sums[0]) / n : 0.0;
+    stats_.mean_interactions = n > 0 ? double(sums[1]) / n : 0.0;
+    stats_.tree_build_seconds = std::chrono::duration<double>(t1 - t0).count();
+    stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  } else if (settings_.method == Method::Direct) {
     const auto t0 = std::chrono::steady_clock::now();
     direct_sum(p, Real(settings_.softening), ctx.block_size, field_, ctx.active);
     stats_ = GravityStats{};

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <optional>
 #include <memory>
 #include <type_traits>
 #include <sstream>
@@ -36,7 +38,7 @@ namespace {
 template <class Real>
 class FrameWriter final : public Observer<Real> {
  public:
-  FrameWriter(const scene::Scene& scene, const RunOptions& options, io::RunFolder& folder)
+  FrameWriter(const scene::Scene& scene, const RunOptions& options, io::RunFolder* folder)
       : formats_(scene.formats), dir_(options.out_dir), series_(dir_ / "particles.pvd"),
         snapshots_(dir_ / "particles.xdmf"), snapshot_info_(snapshot_info(scene)),
         schedule_(scene.output_interval, scene.dt), on_frame_(options.on_frame), folder_(folder) {}
@@ -86,32 +88,39 @@ class FrameWriter final : public Observer<Real> {
  private:
   void write(Simulation<Real>& sim) {
     ScopedPhase phase(sim.timers(), "output");
+    const ParticleSet<Real>& whole = sim.whole_particles();  // collective on ranks
+    if (!folder_) {  // a rank other than 0: rank 0 writes
+      ++frames_;
+      last_step_ = sim.step_count();
+      return;
+    }
+    io::RunFolder& folder = *folder_;
     std::filesystem::path first;
     for (auto format : formats_) {
       std::filesystem::path file;
       if (format == scene::OutputFormat::Vtp) {
         const std::string name = fmt::format("particles_{:06d}.vtp", frames_);
-        file = folder_.claim(dir_ / name);
-        io::write_vtp(file, sim.particles(), sim.time());
-        folder_.claim(dir_ / "particles.pvd");
+        file = folder.claim(dir_ / name);
+        io::write_vtp(file, whole, sim.time());
+        folder.claim(dir_ / "particles.pvd");
         series_.add(sim.time(), name);
       } else if (format == scene::OutputFormat::Hdf5) {
         const std::string name = snapshot_name(frames_);
-        file = folder_.claim(dir_ / name);
+        file = folder.claim(dir_ / name);
         io::SnapshotInfo info = snapshot_info_;
         info.time = sim.time();
-        io::SnapshotLayout layout = io::write_snapshot(file, sim.particles(), info);
-        folder_.claim(snapshots_.path());
+        io::SnapshotLayout layout = io::write_snapshot(file, whole, info);
+        folder.claim(snapshots_.path());
         snapshots_.add(name, std::move(layout));
       } else {
-        file = folder_.claim(dir_ / fmt::format("particles_{:06d}.csv", frames_));
-        io::write_csv(file, sim.particles(), sim.time());
+        file = folder.claim(dir_ / fmt::format("particles_{:06d}.csv", frames_));
+        io::write_csv(file, whole, sim.time());
       }
       if (first.empty()) first = file;
     }
     ++frames_;
     last_step_ = sim.step_count();
-    if (on_frame_) on_frame_(first, sim.time(), [this](const std::filesystem::path& p) { return folder_.claim(p); });
+    if (on_frame_) on_frame_(first, sim.time(), [&folder](const std::filesystem::path& p) { return folder.claim(p); });
   }
 
   static std::string snapshot_name(std::size_t frame) { return fmt::format("particles_{:06d}.h5", frame); }
@@ -138,7 +147,7 @@ class FrameWriter final : public Observer<Real> {
   io::SnapshotInfo snapshot_info_;
   IntervalSchedule schedule_;
   FrameHook on_frame_;
-  io::RunFolder& folder_;
+  io::RunFolder* folder_;  // null on ranks other than 0
   std::size_t frames_ = 0;
   std::uint64_t last_step_ = 0;
 };
@@ -155,7 +164,7 @@ template <class Real>
 class DiagnosticsLog final : public Observer<Real> {
  public:
   DiagnosticsLog(const scene::Scene& scene, const RunOptions& options, const Simulation<Real>& sim,
-                 io::RunFolder& folder)
+                 io::RunFolder* folder)
       : path_(options.out_dir / "diagnostics.csv"), schedule_(scene.output_interval, scene.dt),
         adaptive_(scene.adaptive_dt), dt_max_(scene.dt), block_size_(scene.block_size),
         max_energy_error_(scene.max_energy_error), folder_(folder) {
@@ -221,7 +230,12 @@ class DiagnosticsLog final : public Observer<Real> {
  private:
   void add_row(Simulation<Real>& sim) {
     ScopedPhase phase(sim.timers(), "output");
-    const auto& p = sim.particles();
+    const auto& p = sim.whole_particles();  // collective on ranks
+    if (!folder_) {  // a rank other than 0: rank 0 writes, and checks the energy
+      ++rows_;
+      last_step_ = sim.step_count();
+      return;
+    }
     const Mechanics m = mechanics(p);
     double potential = 0;
     for (const auto& s : sim.solvers()) potential += s->potential_energy(p, block_size_);
@@ -243,7 +257,7 @@ class DiagnosticsLog final : public Observer<Real> {
       frame_dt_min_ = std::numeric_limits<double>::infinity(), frame_dt_max_ = 0;
     }
     text_ += "\n";
-    io::write_file_atomic(folder_.claim(path_), text_);
+    io::write_file_atomic(folder_->claim(path_), text_);
     ++rows_;
     last_step_ = sim.step_count();
     // Checked once the row is written: the log shows the error that stopped the run.
@@ -297,7 +311,7 @@ class DiagnosticsLog final : public Observer<Real> {
   double dt_max_;
   std::size_t block_size_;
   double max_energy_error_;
-  io::RunFolder& folder_;
+  io::RunFolder* folder_;  // null on ranks other than 0
   bool conservative_ = true;
   std::string text_;
   std::size_t rows_ = 0;
@@ -334,7 +348,7 @@ class Checkpointer final : public Observer<Real> {
  public:
   using Collect = std::function<void(NamedValues&)>;
   Checkpointer(const scene::Scene& scene, const RunOptions& options, std::uint64_t scene_hash, Collect collect,
-               io::RunFolder& folder)
+               io::RunFolder* folder)
       : options_(options), schedule_(options.checkpoint_every.value_or(0), scene.dt), hash_(scene_hash),
         collect_(std::move(collect)), folder_(folder) {}
 
@@ -361,16 +375,18 @@ class Checkpointer final : public Observer<Real> {
     ScopedPhase phase(sim.timers(), "output");
     NamedValues values;
     collect_(values);
+    const ParticleSet<Real>& whole = sim.whole_particles();  // collective on ranks
+    const auto path = checkpoint_dir(options_.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count());
+    last_ = path;
+    if (!folder_) return;  // a rank other than 0: rank 0 writes
     // Claimed (and the manifest synced) before it is written: a resume after a
     // power cut still knows it is this run's.
-    const auto file = folder_.claim(
-        checkpoint_dir(options_.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count()), /*sync=*/true);
-    io::write_checkpoint(file, sim.particles(),
-                         {sizeof(Real), sim.particles().size(), hash_, sim.step_count(), sim.time()}, values);
+    const auto file = folder_->claim(path, /*sync=*/true);
+    io::write_checkpoint(file, whole, {sizeof(Real), whole.size(), hash_, sim.step_count(), sim.time()}, values);
     last_ = file;
-    const auto files = checkpoints_in(folder_);
+    const auto files = checkpoints_in(*folder_);
     for (std::size_t k = std::max<std::size_t>(options_.checkpoint_keep, 1); k < files.size(); ++k)
-      folder_.remove(files[k]);
+      folder_->remove(files[k]);
   }
   const std::filesystem::path& last() const { return last_; }
 
@@ -379,7 +395,7 @@ class Checkpointer final : public Observer<Real> {
   IntervalSchedule schedule_;
   std::uint64_t hash_;
   Collect collect_;
-  io::RunFolder& folder_;
+  io::RunFolder* folder_;  // null on ranks other than 0
   std::filesystem::path last_;
   std::uint64_t last_step_ = 0;
 };
@@ -548,6 +564,39 @@ std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<R
                                 summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
 }
 
+// On several ranks: the checkpoint rank 0 chose (read_newest_checkpoint), read
+// by every other rank whole (Simulation::resume keeps its share).
+std::filesystem::path agree_on_path(const dist::Communicator& comm, const std::filesystem::path& mine) {
+  const std::string text = mine.string();
+  dist::Bytes bytes(text.size());
+  std::memcpy(bytes.data(), text.data(), text.size());
+  const std::vector<dist::Bytes> all = comm.all_gather(bytes);
+  return std::string(reinterpret_cast<const char*>(all[0].data()), all[0].size());
+}
+
+// What stopped a stage of the loop: a blow-up, a failed write; empty: nothing.
+struct Failure {
+  std::string error;
+  std::string blow_up;
+};
+
+// On several ranks every rank must leave the loop at the same step: a failure
+// on one rank (rank 0's write, its energy check) is made every rank's, with
+// the words of the lowest rank that failed.
+Failure agree(const dist::Communicator& comm, const Failure& mine) {
+  if (!comm.distributed()) return mine;
+  const std::string text = mine.error.empty() ? std::string() : mine.blow_up + '\n' + mine.error;
+  dist::Bytes bytes(text.size());
+  std::memcpy(bytes.data(), text.data(), text.size());
+  for (const dist::Bytes& b : comm.all_gather(bytes)) {
+    if (b.empty()) continue;
+    const std::string all(reinterpret_cast<const char*>(b.data()), b.size());
+    const auto cut = all.find('\n');
+    return {all.substr(cut + 1), all.substr(0, cut)};
+  }
+  return {};
+}
+
 template <class Real>
 RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::uintmax_t first_output_bytes,
                      const std::function<void(const RunProgress&)>& on_progress) {
@@ -558,7 +607,25 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   summary.threads = parallel::thread_count();
   const std::uint64_t hash = scene::scene_hash(scene);
 
+  const dist::Communicator& comm = options.ranks ? *options.ranks : dist::Communicator::world();
+  const bool on_ranks = options.ranks && options.ranks->distributed();
+  const bool root = !on_ranks || comm.is_root();
   Simulation<Real> sim = build_simulation<Real>(scene);
+  if (on_ranks) {
+    if (const std::string no = distributed_support(scene, sim.particles()); !no.empty())
+      throw std::invalid_argument(fmt::format("{}: {} does not run on several MPI ranks yet ({} ranks were started); "
+                                              "run it on one (docs/design/mpi.md says what is distributed so far)",
+                                              scene.file, no, comm.size()));
+    if (options.extend_float || options.extend_double)
+      throw std::invalid_argument("solvers and observers added from Python do not run on several MPI ranks");
+    if (sim.particles().size() < static_cast<std::size_t>(comm.size()))
+      throw std::invalid_argument(fmt::format("{}: {} particles on {} MPI ranks: every rank needs at least one "
+                                              "particle; run on at most {} rank{}",
+                                              scene.file, sim.particles().size(), comm.size(),
+                                              std::max<std::size_t>(sim.particles().size(), 1),
+                                              sim.particles().size() > 1 ? "s" : ""));
+    sim.distribute(comm);
+  }
   std::vector<std::shared_ptr<Observer<Real>>> added;
   if constexpr (std::is_same_v<Real, float>) {
     if (options.extend_float) added = options.extend_float(sim);
@@ -567,22 +634,44 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   }
   // Only now, so that a scene refused while its particles are built leaves no
   // empty output directory behind; nothing has been run yet.
-  io::ensure_writable_directory(options.out_dir, first_output_bytes);
-  // The folder is this run's for as long as it runs (a lock), and it writes
-  // only files that are its own (io/run_folder.hpp).
-  io::RunFolder folder(options.out_dir,
-                       options.resume      ? io::RunFolderMode::Resume
-                       : options.overwrite ? io::RunFolderMode::Overwrite
-                                           : io::RunFolderMode::Fresh,
-                       fmt::format("{} {:016x}", scene.file, hash));
+  // On several ranks only rank 0 writes, so only rank 0 takes the folder.
+  // Set-up that rank 0 does alone: on several ranks its failure (a folder
+  // that cannot be written or holds another run, no checkpoint to resume
+  // from) is made every rank's, as bad input (std::invalid_argument).
+  auto on_root = [&](auto&& body) {
+    if (!on_ranks) return body();
+    Failure failure;
+    if (root) {
+      try {
+        body();
+      } catch (const std::exception& e) {
+        failure.error = e.what();
+      }
+    }
+    failure = agree(comm, failure);
+    if (!failure.error.empty()) throw std::invalid_argument(failure.error);
+  };
+  std::optional<io::RunFolder> folder_of_run;
+  on_root([&] {
+    io::ensure_writable_directory(options.out_dir, first_output_bytes);
+    // The folder is this run's for as long as it runs (a lock), and it writes
+    // only files that are its own (io/run_folder.hpp).
+    folder_of_run.emplace(options.out_dir,
+                          options.resume      ? io::RunFolderMode::Resume
+                          : options.overwrite ? io::RunFolderMode::Overwrite
+                                              : io::RunFolderMode::Fresh,
+                          fmt::format("{} {:016x}", scene.file, hash));
+  });
+  io::RunFolder* folder = folder_of_run ? &*folder_of_run : nullptr;
   // Valid but likely to hurt (zero softening): said before the first step.
   for (const std::string& w : scene::advisories(scene)) {
+    if (!root) break;
     if (options.on_warning) options.on_warning(w);
     else summary.warnings.push_back(w);
   }
   sim.set_on_blow_up(options.on_blow_up);
   sim.prepare();  // every field declared, so a checkpoint's fields meet their uses
-  summary.particles = sim.particles().size();
+  summary.particles = sim.particles().size();  // on ranks: still the whole set (distribute() keeps it until start)
 
   // Where the run ends (RunEnd): decided once the clock is known (below).
   const bool adaptive = scene.adaptive_dt;
@@ -614,7 +703,14 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   observers.push_back(progress.get());
 
   if (options.resume) {
-    const auto [header, values] = read_newest_checkpoint(sim, folder, hash, summary);
+    std::pair<io::CheckpointHeader, NamedValues> read;
+    on_root([&] { read = read_newest_checkpoint(sim, *folder, hash, summary); });
+    if (on_ranks) {
+      const std::filesystem::path file = agree_on_path(comm, summary.last_checkpoint);
+      if (!root) read.first = io::read_checkpoint(file, sim.particles(), read.second);
+      summary.last_checkpoint = file;
+    }
+    const auto& [header, values] = read;
     SimulationClock clock{header.step, header.time, find_value(values, "clock.previous_dt").value_or(0),
                           find_value(values, "clock.dt_floor").value_or(0)};
     sim.resume(clock, values);
@@ -628,16 +724,44 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
           options.out_dir.string(), end.describe(), sim.step_count(), sim.time()));
   } else {
     end = RunEnd::choose(scene, options, 0, 0.0, nullptr);
-    io::write_file_atomic(folder.claim(options.out_dir / "scene.toml"),
-                          scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
+    if (root)
+      io::write_file_atomic(folder->claim(options.out_dir / "scene.toml"),
+                            scene.toml.empty() ? std::string("# built in code\n") : scene.toml);
   }
   auto running = [&] { return end.to_time ? sim.time() < end.time : sim.step_count() < end.step; };
 
-  try {
+  // One stage of the run: a blow-up or a failed write ends the run with its
+  // message in the summary (on several ranks: on every rank, agree()).
+  auto stage = [&](auto&& body) {
+    Failure failure;
+    try {
+      body();
+    } catch (const SimulationError& e) {
+      failure = {e.what(), std::string(to_string(e.cause()))};
+    } catch (const io::IoError& e) {
+      failure = {fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what()), ""};
+    } catch (const std::filesystem::filesystem_error& e) {
+      failure = {fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what()), ""};
+    }
+    if (on_ranks) failure = agree(comm, failure);
+    summary.error = failure.error;
+    summary.blow_up = failure.blow_up;
+    return failure.error.empty();
+  };
+  // A stop asked on any rank (mpirun passes SIGINT and SIGTERM to every rank).
+  auto stop_asked = [&] {
+    double asked[1] = {options.stop && options.stop->load() ? 1.0 : 0.0};
+    if (on_ranks) comm.max(asked);
+    return asked[0] > 0;
+  };
+
+  bool going = stage([&] {
     if (!options.resume) sim.start();  // solvers fill their fields (density, potential) here
     summary.bytes_per_particle = bytes_per_particle(sim);
     for (Observer<Real>* o : observers) o->on_start(sim, options.resume);
-    while (running()) {
+  });
+  while (going && running()) {
+    going = stage([&] {
       std::optional<double> land;
       if (adaptive) {  // land exactly on the end time and on the observers' next times
         if (end.to_time) land = end.time;
@@ -646,22 +770,15 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
       }
       sim.step(land);
       for (Observer<Real>* o : observers) o->on_step(sim);
-      if (options.stop && options.stop->load()) {
-        checkpoints->write(sim);
-        summary.interrupted = true;
-        break;
-      }
+    });
+    if (going && stop_asked()) {
+      summary.interrupted = stage([&] { checkpoints->write(sim); });
+      break;
     }
-    if (!summary.interrupted)
-      for (Observer<Real>* o : observers) o->on_finish(sim);
-  } catch (const SimulationError& e) {
-    summary.error = e.what();
-    summary.blow_up = std::string(to_string(e.cause()));
-  } catch (const io::IoError& e) {
-    summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
-  } catch (const std::filesystem::filesystem_error& e) {
-    summary.error = fmt::format("writing output failed at step {}: {}", sim.step_count(), e.what());
   }
+  if (going && !summary.interrupted) stage([&] {
+      for (Observer<Real>* o : observers) o->on_finish(sim);
+    });
 
   summary.failed_checks = guard->failed_checks();
   if (!checkpoints->last().empty()) summary.last_checkpoint = checkpoints->last();
@@ -674,12 +791,33 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   for (const auto& s : sim.solvers()) s->add_metrics(summary.metrics);
   sim.stepper().add_metrics(summary.metrics);
   if (const auto error = diagnostics->energy_error()) summary.metrics.emplace_back("relative_energy_error", *error);
-  if (sim.order().active()) summary.metrics.emplace_back("sorts", double(sim.order().sorts()));
+  if (sim.ranks()) {
+    if (sim.ranks()->active()) summary.metrics.emplace_back("sorts", double(sim.ranks()->sorts()));
+  } else if (sim.order().active()) {
+    summary.metrics.emplace_back("sorts", double(sim.order().sorts()));
+  }
   if (adaptive && progress->dt_max() > 0) {  // landing steps included
     summary.metrics.emplace_back("smallest_dt", progress->dt_min());
     summary.metrics.emplace_back("largest_dt", progress->dt_max());
   }
   return summary;
+}
+
+// What of a scene (built: its particles) does not run on several ranks yet.
+template <class Real>
+std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<Real>& particles) {
+  if (scene.nbody) {
+    if (scene.time_steps == scene::TimeSteps::Block) return "simulation.time_steps = \"block\"";
+    const std::string no = gravity::GravityForce<Real>(*scene.nbody).distributed_support();
+    if (!no.empty()) return "self-gravity with " + no;
+  }
+  if (scene.sph) {
+    const std::string no = sph::SphFluid<Real>(*scene.sph).distributed_support();
+    if (!no.empty()) return no;
+  }
+  if (particles.find_int_field(kKindField) != ParticleSet<Real>::npos)
+    return "boundary particles (box.walls = \"particles\", obstacles)";
+  return {};
 }
 
 // Memory and disk a scene needs, estimated before anything is allocated.
@@ -729,6 +867,13 @@ std::uint64_t memory_available() {
 }
 
 }  // namespace
+
+std::string distributed_support(const scene::Scene& scene, const ParticleSet<float>& particles) {
+  return distributed_support_of(scene, particles);
+}
+std::string distributed_support(const scene::Scene& scene, const ParticleSet<double>& particles) {
+  return distributed_support_of(scene, particles);
+}
 
 void check_memory(const scene::Scene& scene) {
   const Footprint f = footprint(scene);

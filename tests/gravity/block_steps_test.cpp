@@ -161,7 +161,7 @@ TYPED_TEST(BlockStepsTest, GravityForceAddsOnlyToTheActiveParticles) {
   g.declare_fields(p);
   const std::vector<std::int32_t> bins = scattered_bins(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) p.acceleration.set(i, Vec3<Real>{1, 2, 3});
-  SolverContext<Real> ctx{0, 64, nullptr, nullptr, ActiveSet{bins.data(), 3}};
+  SolverContext<Real> ctx{0, 64, nullptr, nullptr, ActiveSet{bins.data(), 3}, nullptr};
   g.add_acceleration(p, ctx);
   GravityField<Real> full;
   BarnesHut<Real>(GravitySettings{}).compute(p, full, 64);

@@ -283,12 +283,12 @@ TEST(PushForce, RelaxesVelocitiesTowardTheDragWithinItsRadiusOnly) {
   }
   PushForce<double> push;
   push.set(control::Push{{0, 0, 0}, {1, 0, 0}, 1.0f, 10, true});
-  push.add_acceleration(p, SolverContext<double>{0, 1, nullptr, nullptr, {}});
+  push.add_acceleration(p, SolverContext<double>{0, 1, nullptr, nullptr, {}, nullptr});
   EXPECT_DOUBLE_EQ(p.acceleration.x[0], 10.0);            // at the point: s·(u − v)
   EXPECT_NEAR(p.acceleration.x[1], 10.0 * 0.4, 1e-6);     // 0.6 R away: (1 − 0.6)
   EXPECT_EQ(p.acceleration.x[2], 0.0);                    // outside R
   push.set(control::Push{{0, 0, 0}, {1, 0, 0}, 1.0f, 10, false});
-  push.add_acceleration(p, SolverContext<double>{0, 1, nullptr, nullptr, {}});
+  push.add_acceleration(p, SolverContext<double>{0, 1, nullptr, nullptr, {}, nullptr});
   EXPECT_DOUBLE_EQ(p.acceleration.x[0], 10.0);  // off: nothing added
 }
 

@@ -107,6 +107,10 @@ class ParticleSet {
   void for_each_int_array(F&& f) {
     for (auto& e : int_extra_) f(e.data);
   }
+  template <class F>
+  void for_each_int_array(F&& f) const {
+    for (const auto& e : int_extra_) f(e.data);
+  }
 
   // Adds an extra field (zero-filled) and returns its index; if a field of that
   // name and shape exists already, returns its index (and keeps its use).

@@ -30,6 +30,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -38,10 +39,16 @@
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/phase_timers.hpp"
+#include "swirl/dist/communicator.hpp"
 #include "swirl/force/step_scan.hpp"
 #include "swirl/spatial/particle_order.hpp"
 
 namespace swirl {
+
+namespace dist {
+template <class Real>
+class RankOrder;
+}  // namespace dist
 
 // What a solver may know about the evaluation it is called in.
 template <class Real>
@@ -51,6 +58,10 @@ struct SolverContext {
   PhaseTimers* timers = nullptr;                        // where a solver may time its sub-phases
   const spatial::ParticleOrder<Real>* order = nullptr;  // the particle order, current for these positions
   ActiveSet active;  // the particles to compute (block time steps); others' acceleration may be left as is
+  // On several ranks (dist/rank_order.hpp): the global order this rank's
+  // particles are a range of (order is then null). A solver that does not run
+  // on ranks throws std::invalid_argument; the run refuses such scenes first.
+  const dist::RankOrder<Real>* ranks = nullptr;
 };
 
 // A limit's words for the guard: the rule with its numbers, and the change that relaxes it.
@@ -77,6 +88,16 @@ class Solver {
 
   // Adds this solver's acceleration into particles.acceleration (see the header).
   virtual void add_acceleration(ParticleSet<Real>& particles, const SolverContext<Real>& ctx) = 0;
+
+  // On several ranks: where the ranks' key ranges may end. Given this rank's
+  // keys (dist::RankOrder's, this evaluation's) and cuts balanced by count,
+  // returns the cuts this solver's passes need (self-gravity: on group
+  // boundaries of the global tree). Collective; the same cuts on every rank.
+  virtual std::vector<std::uint64_t> rank_cuts(const dist::Communicator& /*comm*/,
+                                               std::span<const std::uint64_t> /*keys*/,
+                                               std::vector<std::uint64_t> cuts) const {
+    return cuts;
+  }
 
   // Time-step conditions.
   virtual ScanNeeds scan_needs() const { return {}; }
@@ -120,7 +141,7 @@ void evaluate_alone(Solver<Real>& solver, ParticleSet<Real>& particles, spatial:
   solver.declare_fields(particles);
   order.set_request(solver.order_request());
   order.update(particles, block_size);
-  solver.add_acceleration(particles, SolverContext<Real>{time, block_size, timers, order.active() ? &order : nullptr, {}});
+  solver.add_acceleration(particles, SolverContext<Real>{time, block_size, timers, order.active() ? &order : nullptr, {}, nullptr});
 }
 
 // The same with an order made for this one call (no skin carried over).

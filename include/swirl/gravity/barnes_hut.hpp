@@ -95,6 +95,8 @@ class BarnesHut {
                       const std::array<double, 3>& corner, double side, GravityField<Real>& out,
                       std::size_t block_size, const ActiveSet& active = {});
 
+  // The linear octree's settings from these (multipole, opening, buckets, walk, ...).
+  LinearTreeSettings linear_settings() const;
   // True when compute() walks the linear octree (scheme global, tree linear).
   bool uses_linear_tree() const { return settings_.scheme == Scheme::Global && settings_.tree == Tree::Linear; }
   // The linear octree of the last evaluation (empty unless uses_linear_tree()).
@@ -137,7 +139,6 @@ class BarnesHut {
                     const ActiveSet& active);
   void compute_linear(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
                       const ActiveSet& active);
-  LinearTreeSettings linear_settings() const;
   void evaluate_linear(std::size_t n, GravityField<Real>& out, std::size_t block_size, double build_seconds,
                        const ActiveSet& active);
   void build_subdomains(const ParticleSet<Real>& p);

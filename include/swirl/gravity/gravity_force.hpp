@@ -30,6 +30,10 @@
 // the run: the cost measure block steps are judged by.
 //
 // Results are bit-identical for any thread count.
+// On several ranks (SolverContext::ranks) the linear octree's group walk
+// runs as the locally essential tree (essential_tree.hpp) over the global
+// order, whose cuts rank_cuts() puts on group boundaries: every particle's
+// field is the one-rank field, bit for bit. Other methods are refused there.
 #pragma once
 
 #include <string>
@@ -38,6 +42,7 @@
 
 #include "swirl/force/solver.hpp"
 #include "swirl/gravity/barnes_hut.hpp"
+#include "swirl/gravity/essential_tree.hpp"
 #include "swirl/gravity/field.hpp"
 #include "swirl/gravity/fmm.hpp"
 #include "swirl/gravity/settings.hpp"
@@ -60,6 +65,12 @@ class GravityForce final : public Solver<Real> {
   void declare_fields(ParticleSet<Real>& particles) override;
   spatial::OrderRequest order_request() const override;
   void add_acceleration(ParticleSet<Real>& particles, const SolverContext<Real>& ctx) override;
+  // On ranks: cuts on group boundaries of the global tree (group_aligned_cuts).
+  std::vector<std::uint64_t> rank_cuts(const dist::Communicator& comm, std::span<const std::uint64_t> keys,
+                                       std::vector<std::uint64_t> cuts) const override;
+  // Empty when these settings run on several ranks (the linear octree's group
+  // walk, as a view of the order: the locally essential tree); otherwise what does not.
+  std::string distributed_support() const;
 
   ScanNeeds scan_needs() const override { return {false, !(settings_.softening > 0)}; }
   void add_limits(const StepScan& scan, std::size_t n, std::vector<StepLimit>& out) const override;
@@ -91,6 +102,7 @@ class GravityForce final : public Solver<Real> {
   GravitySettings settings_;
   SelfGravityOptions options_;
   BarnesHut<Real> tree_;
+  EssentialTree<Real> essential_;  // on several ranks
   Fmm<Real> fmm_;
   GravityField<Real> field_;
   GravityStats stats_;

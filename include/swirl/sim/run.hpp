@@ -33,6 +33,8 @@
 #include <utility>
 #include <vector>
 
+#include "swirl/core/particle_set.hpp"
+#include "swirl/dist/communicator.hpp"
 #include "swirl/scene/scene.hpp"
 #include "swirl/sim/blow_up.hpp"
 
@@ -109,6 +111,14 @@ struct RunOptions {
   // Called with each warning of OnBlowUp::Warn, rate-limited: the 1st, 10th,
   // 100th, ... failure of each kind of check.
   std::function<void(const std::string& warning)> on_warning;
+
+  // The ranks to run on (the CLI under mpirun: dist::Communicator::world());
+  // null or one rank: this process alone. On several ranks every rank builds
+  // the scene (or reads the checkpoint) whole and keeps its share; rank 0
+  // alone takes the folder's lock and writes every file, from the whole state
+  // gathered to it, so the files are those of a one-rank run byte for byte;
+  // the hooks and warnings run on rank 0 only (docs/design/mpi.md).
+  const dist::Communicator* ranks = nullptr;
 };
 
 // Reported after start() and after every step.
@@ -148,6 +158,11 @@ struct RunSummary {
   // did not do what was asked, though it reached its end (the CLI exits 1).
   std::vector<std::string> failed_checks;
 };
+
+// What of a scene does not run on several ranks yet ("self-gravity
+// ([nbody])", ...), given its built particles; empty when all of it does.
+std::string distributed_support(const scene::Scene& scene, const ParticleSet<float>& particles);
+std::string distributed_support(const scene::Scene& scene, const ParticleSet<double>& particles);
 
 // Refuses, before anything is allocated, a scene whose particles would not fit
 // in the free memory (std::invalid_argument with the estimate and the limit).

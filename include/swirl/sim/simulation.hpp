@@ -33,6 +33,18 @@
 // orbits' energy errors can drift instead of staying bounded; gravity runs that
 // need a bounded error keep a fixed Δt (docs/stability.md).
 //
+// Several ranks (distribute(), issue 19; docs/design/mpi.md): every rank
+// builds (or reads) the whole set, then keeps its range of the global order
+// (dist/rank_order.hpp) and steps only its own particles; the solvers get the
+// rank order in their context in place of the one-rank order (SPH exchanges
+// ghosts). Whatever decides the run's course is global and exact: the scan is
+// each rank's block-order fold, with global indices, folded again in rank
+// order (the one-rank fold's result); the limits count all particles; a
+// failed check is found on every rank at once, and its message (a particle's
+// fields) comes from the rank that holds the particle. whole_particles()
+// gathers the one-rank memory order on rank 0 for frames and checkpoints.
+// So every rank count gives the one-rank bits.
+//
 // Checkpoints: save_state()/resume() carry the clock, the controller, the
 // stepper's and every solver's state; the particle fields (including the
 // order's reference positions when a skin is used) travel in the checkpoint's
@@ -43,12 +55,14 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -59,6 +73,9 @@
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/phase_timers.hpp"
+#include "swirl/dist/communicator.hpp"
+#include "swirl/dist/gather_particles.hpp"
+#include "swirl/dist/rank_order.hpp"
 #include "swirl/force/solver.hpp"
 #include "swirl/force/step_scan.hpp"
 #include "swirl/integrate/kick_drift.hpp"
@@ -110,6 +127,33 @@ class Simulation {
     }
   }
 
+  // Runs on the ranks of comm (a no-op on one rank): call before start() or
+  // resume(), with the whole set in particles() on every rank; start() or
+  // resume() then keeps this rank's share (see the header).
+  void distribute(const dist::Communicator& comm) {
+    if (started_) throw std::logic_error("Simulation::distribute() after start()");
+    if (comm.distributed()) ranks_ = std::make_unique<dist::RankOrder<Real>>(comm);
+  }
+  // The rank order on several ranks, or null.
+  const dist::RankOrder<Real>* ranks() const { return ranks_.get(); }
+  bool is_root() const { return !ranks_ || ranks_->comm().is_root(); }
+  // Particles in the whole run (this rank's on one rank).
+  std::uint64_t global_count() const { return ranks_ ? ranks_->global_count() : particles_.size(); }
+
+  // The whole state in the one-rank memory order, for frames and checkpoints.
+  // Collective on several ranks: there rank 0 gets every particle (gathered
+  // once per step and order) and the other ranks an empty set.
+  const ParticleSet<Real>& whole_particles() const {
+    if (!ranks_) return particles_;
+    const auto stamp = std::make_pair(clock_.step, epoch());
+    if (!gathered_valid_ || gathered_stamp_ != stamp) {
+      gathered_ = dist::gather_to_root(ranks_->comm(), particles_);
+      gathered_stamp_ = stamp;
+      gathered_valid_ = true;
+    }
+    return gathered_;
+  }
+
   // What a failed check does from now on (the settings' on_blow_up until then).
   void set_on_blow_up(OnBlowUp policy) { settings_.on_blow_up = policy; }
 
@@ -134,6 +178,13 @@ class Simulation {
       needs_ |= s->scan_needs();
     }
     order_.set_request(request);
+    if (ranks_) {
+      ranks_->set_request(request);
+      ranks_->set_cut_rule([this](std::span<const std::uint64_t> keys, std::vector<std::uint64_t> cuts) {
+        for (const auto& s : solvers_) cuts = s->rank_cuts(ranks_->comm(), keys, std::move(cuts));
+        return cuts;
+      });
+    }
     if (request.keep_within > 0) particles_.add_field(std::string(spatial::ParticleOrder<Real>::kReferenceField), 3, FieldUse::Internal);
     prepared_ = true;
   }
@@ -141,6 +192,7 @@ class Simulation {
   // Computes a₀ = F(x₀) (and whatever the stepper keeps). Call once before the first step().
   void start() {
     prepare();
+    if (ranks_) ranks_->adopt(particles_, false);
     Evaluation forces(*this);
     stepper_->start(particles_, forces, time(), settings_.block_size);
     rescan();
@@ -167,7 +219,10 @@ class Simulation {
     clock_ = clock;
     stepper_->load_state(state);
     for (auto& s : solvers_) s->load_state(state);
-    order_.resume(particles_, settings_.block_size);
+    if (ranks_)
+      ranks_->adopt(particles_, true);
+    else
+      order_.resume(particles_, settings_.block_size);
     rescan();  // the limits are a function of the restored fields: the same as before the stop
     started_ = true;
   }
@@ -211,14 +266,15 @@ class Simulation {
     request.timers = &timers_;
     Evaluation forces(*this);
     const integrate::StepOutcome outcome = stepper_->advance(particles_, forces, request);
-    scan_ = outcome.scan;
+    scan_ = global_scan(outcome.scan);
+    const integrate::Escape escape = global_escape(outcome.escape);
     ++clock_.step;
     clock_.time = t_next;
     last_dt_ = dt_step;
     evaluate_limits();
     if (scan_.non_finite != kNoParticle) throw_non_finite(scan_.non_finite);
     if (!checks) return;
-    if (outcome.escape.found) report(BlowUpCause::LeftDomain, escape_message(outcome.escape));
+    if (escape.found) report(BlowUpCause::LeftDomain, escape_message(escape));
     if (!outcome.not_converged.empty())
       report(BlowUpCause::NotConverged, fmt::format("{}: blow-up: {}", where(), outcome.not_converged));
     const StepLimit& tight = tightest();
@@ -272,7 +328,7 @@ class Simulation {
   ParticleSet<Real>& particles() { return particles_; }
   const spatial::ParticleOrder<Real>& order() const { return order_; }
   // Changes whenever the particles' memory order or count may have changed.
-  std::uint64_t epoch() const { return order_.epoch(); }
+  std::uint64_t epoch() const { return order_.epoch() + (ranks_ ? ranks_->epoch() + evaluations_on_ranks_ : 0); }
   PhaseTimers& timers() { return timers_; }
   const PhaseTimers& timers() const { return timers_; }
   const std::vector<std::unique_ptr<Solver<Real>>>& solvers() const { return solvers_; }
@@ -312,7 +368,15 @@ class Simulation {
                                     for (std::size_t i = b; i < e; ++i) a[i] = Real(0);
                                   }
                                 });
-    if (order_.active()) {
+    if (ranks_) {
+      ++evaluations_on_ranks_;  // the SPH ghosts come and go: buffers may move
+      ScopedPhase sort(timers_, "forces.sort");
+      try {
+        ranks_->update(particles_, settings_.block_size);
+      } catch (const spatial::NonFinitePosition&) {  // thrown on every rank alike
+        throw_non_finite(first_non_finite_position());
+      }
+    } else if (order_.active()) {
       ScopedPhase sort(timers_, "forces.sort");
       // A position the drift made non-finite stops the sort; it is a blow-up
       // of the state (exit 1, the particle named), not bad input. The search
@@ -323,7 +387,8 @@ class Simulation {
         throw_non_finite(first_non_finite_position());
       }
     }
-    SolverContext<Real> ctx{t, settings_.block_size, &timers_, order_.active() ? &order_ : nullptr, {}};
+    SolverContext<Real> ctx{t, settings_.block_size, &timers_, order_.active() && !ranks_ ? &order_ : nullptr, {},
+                            ranks_.get()};
     if (min_bin > 0) {
       const std::size_t bins = particles_.find_int_field(integrate::kTimeBinField);
       if (bins == ParticleSet<Real>::npos) throw std::logic_error("Simulation: an active evaluation without time bins");
@@ -350,20 +415,77 @@ class Simulation {
                                 });
   }
 
-  // The first particle whose position is not finite (the order found one).
+  // The first particle whose position is not finite (the order found one);
+  // on ranks its global index (collective).
   std::size_t first_non_finite_position() const {
+    std::size_t found = kNoParticle;
     for (std::size_t i = 0; i < particles_.size(); ++i)
       if (!std::isfinite(particles_.position.x[i]) || !std::isfinite(particles_.position.y[i]) ||
-          !std::isfinite(particles_.position.z[i]))
-        return i;
-    return 0;
+          !std::isfinite(particles_.position.z[i])) {
+        found = i;
+        break;
+      }
+    if (!ranks_) return found == kNoParticle ? 0 : found;
+    double first[1] = {found == kNoParticle ? std::numeric_limits<double>::infinity()
+                                            : double(ranks_->first_global_index() + found)};
+    ranks_->comm().min(first);
+    return std::isfinite(first[0]) ? static_cast<std::size_t>(first[0]) : 0;
+  }
+
+  // On ranks: the step's scan of every rank (block-order folds, indices made
+  // global) folded in rank order, on every rank: the one-rank fold.
+  StepScan global_scan(StepScan mine) const {
+    if (!ranks_) return mine;
+    const std::size_t first = ranks_->first_global_index();
+    for (std::size_t* index : {&mine.non_finite, &mine.speed_at, &mine.accel_at, &mine.density_at})
+      if (*index != kNoParticle) *index += first;
+    StepScan all;
+    for (const dist::Bytes& b : ranks_->comm().all_gather(to_bytes(mine))) all = StepScan::combine(all, from_bytes<StepScan>(b));
+    return all;
+  }
+  // The same for the drift's escape (the largest excess, the first on ties).
+  integrate::Escape global_escape(const integrate::Escape& mine) const {
+    if (!ranks_) return mine;
+    integrate::Escape all;
+    for (const dist::Bytes& b : ranks_->comm().all_gather(to_bytes(mine))) {
+      const auto e = from_bytes<integrate::Escape>(b);
+      if (e.excess > all.excess) all = e;
+    }
+    return all;
+  }
+  template <class T>
+  static dist::Bytes to_bytes(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    dist::Bytes b(sizeof(T));
+    std::memcpy(b.data(), &value, sizeof(T));
+    return b;
+  }
+  template <class T>
+  static T from_bytes(const dist::Bytes& b) {
+    T value{};
+    if (b.size() != sizeof(T)) throw std::runtime_error("Simulation: a rank sent a record of the wrong size");
+    std::memcpy(&value, b.data(), sizeof(T));
+    return value;
+  }
+  // On ranks: text that the rank holding global particle `index` makes
+  // (make(local index)), on every rank (collective).
+  template <class Make>
+  std::string from_owner(std::size_t index, Make&& make) const {
+    const std::uint64_t first = ranks_->first_global_index();
+    std::string mine;
+    if (index >= first && index < first + particles_.size()) mine = make(static_cast<std::size_t>(index - first));
+    dist::Bytes b(mine.size());
+    std::memcpy(b.data(), mine.data(), mine.size());
+    for (const dist::Bytes& part : ranks_->comm().all_gather(b))
+      if (!part.empty()) return std::string(reinterpret_cast<const char*>(part.data()), part.size());
+    return "?";
   }
 
   void evaluate_limits() {
     limits_.clear();
     for (std::size_t k = 0; k < solvers_.size(); ++k) {
       const std::size_t first = limits_.size();
-      solvers_[k]->add_limits(scan_, particles_.size(), limits_);
+      solvers_[k]->add_limits(scan_, global_count(), limits_);
       for (std::size_t j = first; j < limits_.size(); ++j) limits_[j].source = k;
     }
   }
@@ -373,13 +495,16 @@ class Simulation {
     scan_ = parallel::reduce_blocks_pinned(
         "scan", particles_.size(), settings_.block_size, StepScan{},
         [&](std::size_t b, std::size_t e) { return scan_block(particles_, b, e, needs_); }, &StepScan::combine);
+    scan_ = global_scan(scan_);
     evaluate_limits();
   }
 
   // "step 12 (t = 0.0048)": where a message happened.
   std::string where() const { return fmt::format("step {} (t = {:.6g})", clock_.step, time()); }
 
+  // The id of particle `index` (global on ranks: collective).
   std::string particle_id(std::size_t index) const {
+    if (ranks_) return from_owner(index, [&](std::size_t i) { return std::to_string(particles_.id[i]); });
     return index < particles_.size() ? std::to_string(particles_.id[index]) : std::string("?");
   }
 
@@ -407,19 +532,9 @@ class Simulation {
     return std::min(base / 4, tightest().dt);
   }
 
-  [[noreturn]] void throw_non_finite(std::size_t i) const {
-    // Name every non-finite quantity of the particle, in field order.
-    std::string names;
-    for (const auto& f : particles_.fields())
-      for (int c = 0; c < f.components; ++c)
-        if (!std::isfinite(f.data[static_cast<std::size_t>(c)][i])) {
-          names += fmt::format("{}{}", names.empty() ? "" : ", ", f.name);
-          break;
-        }
+  [[noreturn]] void throw_non_finite(std::size_t index) const {
     const std::string state =
-        fmt::format("particle id {} has a non-finite {} (x = ({}, {}, {}), v = ({}, {}, {}))", particles_.id[i], names,
-                    particles_.position.x[i], particles_.position.y[i], particles_.position.z[i],
-                    particles_.velocity.x[i], particles_.velocity.y[i], particles_.velocity.z[i]);
+        ranks_ ? from_owner(index, [&](std::size_t i) { return particle_state(i); }) : particle_state(index);
     if (!started_)  // start(): the forces of the initial state, no step taken
       throw SimulationError(
           fmt::format("before the first step: blow-up: the forces of the initial state are not finite: {}; no time "
@@ -430,6 +545,21 @@ class Simulation {
     throw SimulationError(fmt::format("{}: blow-up: {}; the time step {} is probably too large for the forces; {}", where(),
                                       state, last_dt_, fix_for_dt(suggested_dt())),
                           BlowUpCause::NonFinite);
+  }
+
+  // "particle id 7 has a non-finite velocity (x = ..., v = ...)": every
+  // non-finite quantity of local particle i, in field order.
+  std::string particle_state(std::size_t i) const {
+    std::string names;
+    for (const auto& f : particles_.fields())
+      for (int c = 0; c < f.components; ++c)
+        if (!std::isfinite(f.data[static_cast<std::size_t>(c)][i])) {
+          names += fmt::format("{}{}", names.empty() ? "" : ", ", f.name);
+          break;
+        }
+    return fmt::format("particle id {} has a non-finite {} (x = ({}, {}, {}), v = ({}, {}, {}))", particles_.id[i], names,
+                       particles_.position.x[i], particles_.position.y[i], particles_.position.z[i],
+                       particles_.velocity.x[i], particles_.velocity.y[i], particles_.velocity.z[i]);
   }
 
   std::string escape_message(const integrate::Escape& e) const {
@@ -469,6 +599,11 @@ class Simulation {
   std::unique_ptr<integrate::Stepper<Real>> stepper_;
   std::vector<std::unique_ptr<Solver<Real>>> solvers_;
   spatial::ParticleOrder<Real> order_;
+  std::unique_ptr<dist::RankOrder<Real>> ranks_;  // several ranks: the global order (order_ unused)
+  std::uint64_t evaluations_on_ranks_ = 0;
+  mutable ParticleSet<Real> gathered_;  // whole_particles() on ranks (filled on rank 0)
+  mutable std::pair<std::uint64_t, std::uint64_t> gathered_stamp_{};  // the step and epoch it was gathered at
+  mutable bool gathered_valid_ = false;
   PhaseTimers timers_;
   ScanNeeds needs_;
   SimulationClock clock_;

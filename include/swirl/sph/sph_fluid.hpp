@@ -90,6 +90,12 @@
 // (DFSPH) or p_b (the thesis's); the fluid's diagnostics and the DFSPH errors
 // count fluid particles only. Boundary particles need the grid search.
 //
+// On several ranks (a context with ranks: dist/rank_order.hpp) each rank
+// computes its own particles among ghosts from the others (dist/halo.hpp,
+// sph/halo_passes.hpp): the thesis's solver on the grid, without boundary
+// particles, gives every particle the one-rank bits. DFSPH, the hash search
+// and boundary particles are refused there for now (distributed_support()).
+//
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
 // Every pass gathers into particle i only: deterministic for any thread count.
 #pragma once
@@ -112,7 +118,9 @@
 #include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sph/dfsph_passes.hpp"
+#include "swirl/dist/rank_order.hpp"
 #include "swirl/sph/grid_passes.hpp"
+#include "swirl/sph/halo_passes.hpp"
 #include "swirl/sph/laws.hpp"
 #include "swirl/sph/parameters.hpp"
 #include "swirl/spatial/cell_grid.hpp"
@@ -167,6 +175,10 @@ class SphFluid final : public Solver<Real> {
   }
 
   void add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) override {
+    if (ctx.ranks) {
+      add_acceleration_ranks(p, ctx);
+      return;
+    }
     if (dfsph()) {
       dfsph_evaluate(p, ctx);
       return;
@@ -300,6 +312,13 @@ class SphFluid final : public Solver<Real> {
     if (!(mu >= 0) || !std::isfinite(mu)) throw std::invalid_argument("SPH: viscosity must be finite and ≥ 0");
     params_.viscosity = mu;
   }
+  // Empty when these parameters run on several ranks; otherwise what does not (yet).
+  std::string distributed_support() const {
+    if (dfsph()) return "sph.method = \"dfsph\"";
+    if (params_.neighbour_search != NeighbourSearch::Grid) return "sph.neighbour_search = \"hash\"";
+    return {};
+  }
+
   // True when the last evaluation used the sorted grid.
   bool used_grid() const { return used_grid_; }
   const StepConditions& conditions() const { return conditions_; }
@@ -427,6 +446,47 @@ class SphFluid final : public Solver<Real> {
       grid_forces(grid_, p, k, ctx.block_size, scratch_, kernel_path());
     }
     return true;
+  }
+
+  // The grid passes on this rank's particles among their ghosts (header):
+  // exchange 1 before the density pass, exchange 2 inside
+  // halo_density_and_forces, the ghosts out again before returning.
+  void add_acceleration_ranks(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
+    const dist::RankOrder<Real>& order = *ctx.ranks;
+    if (const std::string no = distributed_support(); !no.empty())
+      throw std::invalid_argument("SPH on several ranks: " + no + " does not run on several ranks yet");
+    if (kinds(p)) throw std::invalid_argument("SPH on several ranks: boundary particles do not run on several ranks yet");
+    if (!order.cells_fit())
+      throw std::runtime_error(
+          "SPH on several ranks: the particles spread over more than 2^21 grid cells per axis (the one-rank run "
+          "falls back to the hash search here, which does not run on ranks); fix: a box with walls");
+    const dist::Communicator& comm = order.comm();
+    halo_keys_.assign(order.keys().begin(), order.keys().end());
+    dist::Halo halo;
+    {
+      PhaseScope phase(ctx, "forces.halo");
+      halo = dist::Halo::find(comm, order.frame(), halo_keys_, order.first_global_index(), order.global_count(),
+                              order.cut_keys(), kHaloTail<Real>);
+      halo.insert(comm, p, halo_keys_, kHaloFields);
+    }
+    {
+      PhaseScope phase(ctx, "forces.cells");
+      grid_.set_table(params_.cell_table);
+      grid_.view(order.frame(), halo_keys_, halo.global_index(), ctx.block_size);
+    }
+    used_grid_ = true;
+    lists_ = {};
+    std::uint64_t pairs = 0;
+    {
+      PhaseScope phase(ctx, "forces.sph");
+      pairs = halo_density_and_forces(comm, halo, grid_, p, SphLaws<Real>(params_), ctx.block_size, scratch_,
+                                      kernel_path());
+    }
+    halo.remove(p, halo_keys_);
+    // The mean over all particles: an exact integer sum, then the one-rank division.
+    const std::uint64_t all = comm.sum(pairs);
+    mean_neighbours_ = order.global_count() == 0 ? 0.0 : static_cast<double>(all) / static_cast<double>(order.global_count());
+    count_evaluation();
   }
 
   // DFSPH's evaluation: the grid view, ρ and α; no force (the stepper's solves
@@ -567,6 +627,7 @@ class SphFluid final : public Solver<Real> {
   std::optional<DfsphKernel<Real>> kernel_;  // DFSPH: built at the first evaluation
   AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
   AlignedVector<Real> boundary_pressure_;    // thesis's solver: p_b of the last evaluation (scratch)
+  std::vector<std::uint64_t> halo_keys_;     // on ranks: the keys of the own particles and their ghosts (scratch)
   double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
   static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }

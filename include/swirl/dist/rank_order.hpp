@@ -1,0 +1,203 @@
+// RankOrder: spatial::ParticleOrder across the ranks of a distributed run
+// (docs/design/mpi.md; issue 19 items 2 and 5).
+//
+// Each rank holds a contiguous range [first, first + n) of the one global
+// order, and the concatenation of the ranks' particles in rank order is the
+// memory order a one-rank run has at the same step. update() keeps that
+// invariant where ParticleOrder::update() sorts:
+//   1. with a skin, the order is kept while no particle of any rank moved more
+//      than keep_within (a max over ranks: exact);
+//   2. the frame from the global bounding box (dist::global_key_frame: the
+//      frame ParticleOrder would compute for all the particles), every
+//      particle's key in it;
+//   3. cut keys that split the particles evenly (dist::balanced_cut_keys, one
+//      unit of cost per particle), then distribute_in_key_order(): every
+//      particle moves to the rank whose key range holds it, each rank's
+//      particles sorted by (key, previous global index), which is the one-rank
+//      stable sort whatever the rank count; a cut rule (set_cut_rule: the
+//      solvers' Solver::rank_cuts) may move the cuts first, e.g. onto the
+//      gravity tree's group boundaries.
+// So keys(), frame() and the particles' order are the one-rank ones, cut into
+// ranges; where the cuts fall changes no result (the halo's invariants,
+// dist/halo.hpp), only the balance. The cuts are recomputed at every sort:
+// balancing by the last step's interaction counts instead of by count is
+// still to do (issue 19 item 2).
+//
+// adopt(): a run's ranks each build (or read from a checkpoint) the whole
+// set, and each keeps its share: an even slice of the memory order, or, for a
+// checkpoint of a skin run whose reference positions are in sorted order, a
+// slice whose ends fall between different keys, so that the kept order is
+// valid at once and the next update() decides as the uninterrupted run would.
+//
+// Collective: adopt() and update() must be called by every rank. One rank
+// (no MPI) is the trivial case and gives ParticleOrder's order and keys.
+// Units: the positions' (m for SPH).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <span>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "swirl/core/particle_set.hpp"
+#include "swirl/dist/communicator.hpp"
+#include "swirl/dist/gather_particles.hpp"
+#include "swirl/dist/halo.hpp"
+#include "swirl/dist/key_cuts.hpp"
+#include "swirl/dist/key_order.hpp"
+#include "swirl/spatial/particle_order.hpp"
+
+namespace swirl::dist {
+
+template <class Real>
+class RankOrder {
+ public:
+  explicit RankOrder(const Communicator& comm) : comm_(&comm) {}
+
+  const Communicator& comm() const { return *comm_; }
+
+  void set_request(const spatial::OrderRequest& request) {
+    spatial::ParticleOrder<Real> check;  // the same validation and messages
+    check.set_request(request);
+    request_ = request;
+  }
+  const spatial::OrderRequest& request() const { return request_; }
+  bool active() const { return request_.sorted; }
+
+  // Moves the balanced cuts where the solvers need them (collective: every
+  // rank gets this rank's keys and the same cuts, returns the same cuts).
+  using CutRule = std::function<std::vector<std::uint64_t>(std::span<const std::uint64_t> keys,
+                                                           std::vector<std::uint64_t> cuts)>;
+  void set_cut_rule(CutRule rule) { cut_rule_ = std::move(rule); }
+
+  // p holds every particle, the same on every rank, in the one-rank memory
+  // order (a scene's initial state, or a checkpoint's when resumed): keeps
+  // this rank's share (see the header).
+  void adopt(ParticleSet<Real>& p, bool resumed) {
+    const std::size_t n = p.size();
+    const auto ranks = static_cast<std::size_t>(comm_->size()), r = static_cast<std::size_t>(comm_->rank());
+    global_count_ = n;
+    valid_ = false;
+    keys_.clear();
+    cut_keys_.assign(ranks - 1, 0);
+    ++epoch_;
+    std::vector<std::size_t> start(ranks + 1, n);
+    for (std::size_t k = 0; k < ranks; ++k) start[k] = n * k / ranks;
+    const std::size_t ref = p.find_field(spatial::ParticleOrder<Real>::kReferenceField);
+    if (resumed && active() && request_.keep_within > 0 && ref != ParticleSet<Real>::npos) {
+      // The one-rank resume's keys: the reference positions' frame (ParticleOrder::resume).
+      std::array<double, 3> lo{}, hi{};
+      for (int a = 0; a < 3; ++a) {
+        const auto& v = p.extra(ref, a);
+        const auto [mn, mx] = std::minmax_element(v.begin(), v.end());
+        if (n > 0) lo[static_cast<std::size_t>(a)] = double(*mn), hi[static_cast<std::size_t>(a)] = double(*mx);
+      }
+      bool fits = false;
+      frame_ = spatial::ParticleOrder<Real>::frame_for(request_, lo, hi, fits);
+      cells_fit_ = fits;
+      std::vector<std::uint64_t> all(n);
+      for (std::size_t i = 0; i < n; ++i)
+        all[i] = spatial::ParticleOrder<Real>::key_of(frame_, double(p.extra(ref, 0)[i]), double(p.extra(ref, 1)[i]),
+                                                      double(p.extra(ref, 2)[i]));
+      if (std::is_sorted(all.begin(), all.end())) {
+        // Slice ends at the first particle of a key, and the cuts at those keys.
+        for (std::size_t k = 1; k < ranks; ++k) {
+          if (start[k] < n) start[k] = static_cast<std::size_t>(std::lower_bound(all.begin(), all.end(), all[start[k]]) - all.begin());
+          start[k] = std::max(start[k], start[k - 1]);
+          cut_keys_[k - 1] = start[k] < n ? all[start[k]] : std::numeric_limits<std::uint64_t>::max();
+        }
+        keys_.assign(all.begin() + static_cast<std::ptrdiff_t>(start[r]), all.begin() + static_cast<std::ptrdiff_t>(start[r + 1]));
+        valid_ = true;
+      }
+    }
+    first_ = start[r];
+    keep_range(p, start[r], start[r + 1]);
+  }
+
+  // Brings the particles into the global order when the request needs it
+  // (see the header). Returns true when it sorted (on every rank alike).
+  // Throws spatial::NonFinitePosition on every rank when any rank holds a
+  // non-finite position.
+  bool update(ParticleSet<Real>& p, std::size_t block_size) {
+    if (!active()) return false;
+    const bool skin = request_.keep_within > 0;
+    if (skin && valid_ && keys_.size() == p.size() && within_tolerance(p)) return false;
+    bool fits = false;
+    frame_ = global_key_frame(*comm_, p, request_, fits);
+    cells_fit_ = fits;
+    keys_ = keys_in_frame(frame_, p);
+    cut_keys_ = balanced_cut_keys(*comm_, keys_, std::vector<std::uint64_t>(keys_.size(), 1));
+    if (cut_rule_) cut_keys_ = cut_rule_(keys_, std::move(cut_keys_));
+    const Distribution d = distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_);
+    first_ = d.first_global_index;
+    global_count_ = d.global_count;
+    sent_away_ = d.sent_away;
+    if (skin) remember(p, block_size);
+    valid_ = true;
+    ++epoch_;
+    ++sorts_;
+    return true;
+  }
+
+  // After update(): this rank's keys (sorted, one per own particle), the frame,
+  // the cuts, and where the rank's range starts in the global order.
+  std::span<const std::uint64_t> keys() const { return keys_; }
+  const spatial::KeyFrame& frame() const { return frame_; }
+  std::span<const std::uint64_t> cut_keys() const { return cut_keys_; }
+  std::uint64_t first_global_index() const { return first_; }
+  std::uint64_t global_count() const { return global_count_; }
+  bool valid() const { return valid_; }
+  bool cells_fit() const { return cells_fit_; }
+  std::uint64_t epoch() const { return epoch_; }
+  std::uint64_t sorts() const { return sorts_; }
+  std::size_t sent_away() const { return sent_away_; }
+  std::size_t bytes() const { return (keys_.capacity() + cut_keys_.capacity()) * sizeof(std::uint64_t); }
+
+ private:
+  void remember(ParticleSet<Real>& p, std::size_t /*block_size*/) {
+    const std::size_t ref = p.add_field(std::string(spatial::ParticleOrder<Real>::kReferenceField), 3, FieldUse::Internal);
+    for (int a = 0; a < 3; ++a) std::copy(p.position[a].begin(), p.position[a].end(), p.extra(ref, a).begin());
+  }
+
+  // Whether no particle on any rank moved more than keep_within from its
+  // reference position (in double, as ParticleOrder; a max: exact).
+  bool within_tolerance(const ParticleSet<Real>& p) const {
+    const std::size_t ref = p.find_field(spatial::ParticleOrder<Real>::kReferenceField);
+    double worst[1] = {ref == ParticleSet<Real>::npos ? std::numeric_limits<double>::infinity() : 0.0};
+    if (ref != ParticleSet<Real>::npos) {
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const double dx = double(p.position.x[i]) - double(p.extra(ref, 0)[i]),
+                     dy = double(p.position.y[i]) - double(p.extra(ref, 1)[i]),
+                     dz = double(p.position.z[i]) - double(p.extra(ref, 2)[i]);
+        const double d2 = dx * dx + dy * dy + dz * dz;
+        if (!(d2 <= worst[0])) worst[0] = d2 == d2 ? d2 : std::numeric_limits<double>::infinity();
+      }
+    }
+    comm_->max(worst);
+    const double tol = request_.keep_within;
+    return worst[0] <= tol * tol;
+  }
+
+  const Communicator* comm_;
+  spatial::OrderRequest request_;
+  CutRule cut_rule_;
+  spatial::KeyFrame frame_;
+  bool cells_fit_ = true;
+  bool valid_ = false;
+  std::vector<std::uint64_t> keys_;
+  std::vector<std::uint64_t> cut_keys_;
+  std::uint64_t first_ = 0;
+  std::uint64_t global_count_ = 0;
+  std::size_t sent_away_ = 0;
+  std::uint64_t epoch_ = 0;
+  std::uint64_t sorts_ = 0;
+};
+
+}  // namespace swirl::dist

@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# `swirl run` on several MPI ranks (issue 19, points 1, 5, 6 and 7): the same
+# scene (SPH, self-gravity, both) on 1 (no mpirun), 2, 3 and 4 ranks gives byte-identical frames,
+# diagnostics and checkpoints; a run resumes on another rank count and ends
+# with the one-rank bytes; a blow-up stops every rank with the one-rank
+# message and keeps the frames; a scene part that is not distributed yet is
+# refused once with status 2 and leaves no folder; more ranks than particles
+# are refused.
+#
+#   run_on_ranks.sh MPIEXEC SWIRL EXAMPLES   (EXAMPLES: the examples/ folder)
+set -uo pipefail
+mpiexec=$1 swirl=$2 examples=$3
+scene=$examples/dam_break.toml
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+failures=0
+fail() { echo "FAIL: $*"; failures=$((failures + 1)); }
+
+on_ranks() {  # on_ranks N ARGS...: swirl on N ranks (1: without mpirun); status in $status
+  local ranks=$1; shift
+  if [ "$ranks" -eq 1 ]; then
+    "$swirl" "$@" >"$out/stdout" 2>"$out/stderr"
+  else
+    "$mpiexec" -n "$ranks" --oversubscribe --timeout 240 "$swirl" "$@" >"$out/stdout" 2>"$out/stderr"
+  fi
+  status=$?
+}
+# same_files REF DIR WHAT: every frame, the diagnostics and every checkpoint of REF, byte for byte in DIR.
+same_files() {
+  local ref=$1 dir=$2 what=$3 f n=0
+  for f in "$ref"/particles_*.vtp "$ref"/particles.pvd "$ref"/diagnostics.csv "$ref"/checkpoints/*.swc; do
+    [ -e "$f" ] || continue
+    n=$((n + 1))
+    cmp -s "$f" "$dir/${f#"$ref"/}" || fail "$what: ${f#"$ref"/} differs from the one-rank file"
+  done
+  [ "$n" -ge 4 ] || fail "$what: the one-rank run wrote only $n files to compare"
+}
+
+# About 1 900 particles (spacing 3 cm), 30 steps, a frame every 10 steps.
+small=(--set particles.0.spacing=0.03 --set output.interval=0.004)
+
+# 1. Float, fixed dt, row-major cells: 2, 3 and 4 ranks against one.
+on_ranks 1 run "$scene" "${small[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/float_1"
+[ "$status" -eq 0 ] || { fail "float on 1 rank: status $status"; cat "$out/stderr"; }
+for n in 2 3 4; do
+  on_ranks "$n" run "$scene" "${small[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/float_$n"
+  [ "$status" -eq 0 ] || { fail "float on $n ranks: status $status"; cat "$out/stderr"; }
+  same_files "$out/float_1" "$out/float_$n" "float on $n ranks"
+  [ "$(grep -c 'swirl run: done' "$out/stdout")" -eq 1 ] || fail "float on $n ranks: the summary is not printed exactly once"
+done
+
+# 2. Double, adaptive steps, Morton cells with a Verlet skin (the order kept
+#    while no particle of any rank moved half the skin): 3 ranks against one.
+dbl=("${small[@]}" --set 'simulation.precision="double"' --set 'simulation.dt="adaptive"'
+     --set simulation.dt_max=4e-4 --set 'sph.grid.cell_order="morton"' --set sph.grid.skin=0.005)
+on_ranks 1 run "$scene" "${dbl[@]}" --until 0.012 --checkpoint-every 0.004 --out "$out/double_1"
+[ "$status" -eq 0 ] || { fail "double on 1 rank: status $status"; cat "$out/stderr"; }
+on_ranks 3 run "$scene" "${dbl[@]}" --until 0.012 --checkpoint-every 0.004 --out "$out/double_3"
+[ "$status" -eq 0 ] || { fail "double on 3 ranks: status $status"; cat "$out/stderr"; }
+same_files "$out/double_1" "$out/double_3" "double, adaptive, skin on 3 ranks"
+
+# 3. Resume on another rank count: 2 ranks to step 17 (checkpoints at 5, 10,
+#    15), then 3 ranks from step 15 to 30; and 4 ranks resumed on 1.
+for pair in "2 3" "4 1"; do
+  set -- $pair
+  dir="$out/resume_$1_$2"
+  on_ranks "$1" run "$scene" "${small[@]}" --steps 17 --checkpoint-every-steps 5 --out "$dir"
+  [ "$status" -eq 0 ] || { fail "resume $1 -> $2: the first part: status $status"; cat "$out/stderr"; }
+  on_ranks "$2" run --resume "$dir" --steps 15 --checkpoint-every-steps 10
+  [ "$status" -eq 0 ] || { fail "resume $1 -> $2: status $status"; cat "$out/stderr"; }
+  for f in particles_000003.vtp diagnostics.csv checkpoints/checkpoint_000000000030.swc; do
+    cmp -s "$out/float_1/$f" "$dir/$f" || fail "resume $1 -> $2 ranks: $f differs from the uninterrupted one-rank run"
+  done
+done
+
+# 4. Self-gravity (the locally essential tree): a Plummer sphere of 2 000
+#    stars, 12 steps, on 2 and 4 ranks against one; then SPH with self-gravity,
+#    drag and adaptive steps (a self-gravitating drop of 1 500 particles) on 3.
+grav=("$examples/plummer.toml" --set particles.0.count=2000 --set output.interval=0.0625 --steps 12
+      --checkpoint-every-steps 6)
+on_ranks 1 run "${grav[@]}" --out "$out/gravity_1"
+[ "$status" -eq 0 ] || { fail "gravity on 1 rank: status $status"; cat "$out/stderr"; }
+for n in 2 4; do
+  on_ranks "$n" run "${grav[@]}" --out "$out/gravity_$n"
+  [ "$status" -eq 0 ] || { fail "gravity on $n ranks: status $status"; cat "$out/stderr"; }
+  same_files "$out/gravity_1" "$out/gravity_$n" "gravity on $n ranks"
+done
+drop=("$examples/self_gravitating_drop.toml" --set particles.0.count=1500 --until 0.1 --set output.interval=0.025)
+on_ranks 1 run "${drop[@]}" --out "$out/drop_1"
+[ "$status" -eq 0 ] || { fail "drop on 1 rank: status $status"; cat "$out/stderr"; }
+on_ranks 3 run "${drop[@]}" --out "$out/drop_3"
+[ "$status" -eq 0 ] || { fail "drop on 3 ranks: status $status"; cat "$out/stderr"; }
+same_files "$out/drop_1" "$out/drop_3" "SPH with self-gravity on 3 ranks"
+
+# 5. A blow-up (a step far beyond the CFL limit) on 3 ranks: status 1, the
+#    one-rank message exactly, printed once; frame 0 kept.
+big=("${small[@]}" --set simulation.dt=0.01)
+on_ranks 1 run "$scene" "${big[@]}" --steps 20 --out "$out/blow_1"
+[ "$status" -eq 1 ] || fail "blow-up on 1 rank: status $status (want 1)"
+grep 'blow-up' "$out/stderr" | sed "s|$out/blow_1||g" >"$out/blow_1.txt"
+on_ranks 3 run "$scene" "${big[@]}" --steps 20 --out "$out/blow_3"
+[ "$status" -eq 1 ] || fail "blow-up on 3 ranks: status $status (want 1)"
+grep 'blow-up' "$out/stderr" | sed "s|$out/blow_3||g" >"$out/blow_3.txt"
+[ -s "$out/blow_1.txt" ] || fail "blow-up on 1 rank: no message"
+cmp -s "$out/blow_1.txt" "$out/blow_3.txt" || { fail "blow-up on 3 ranks: not the one-rank message"; diff "$out/blow_1.txt" "$out/blow_3.txt"; }
+cmp -s "$out/blow_1/particles_000000.vtp" "$out/blow_3/particles_000000.vtp" || fail "blow-up on 3 ranks: frame 0 lost or changed"
+head -c 400 "$out/blow_3.txt"; echo
+
+# 6. What is not distributed yet is refused once, with status 2, before any folder.
+on_ranks 2 run "$scene" "${small[@]}" --set 'sph.method="dfsph"' --steps 2 --out "$out/refused"
+[ "$status" -eq 2 ] || fail "dfsph on 2 ranks: status $status (want 2)"
+[ "$(grep -c 'does not run on several MPI ranks yet' "$out/stderr")" -eq 1 ] ||
+  fail "dfsph on 2 ranks: the refusal is not printed exactly once"
+[ ! -e "$out/refused" ] || fail "dfsph on 2 ranks: the refused run created its folder"
+cat "$out/stderr"
+on_ranks 2 run "$examples/plummer.toml" --set 'nbody.method="fmm"' --steps 2 --out "$out/refused"
+[ "$status" -eq 2 ] || fail "the FMM on 2 ranks: status $status (want 2)"
+grep -q 'nbody.method = "fmm" does not run on several MPI ranks yet' "$out/stderr" || fail "the FMM on 2 ranks: not said why"
+
+# 7. The folder's lock and files are rank 0's: a second run into a folder
+#    holding another run is refused on every rank with status 2.
+on_ranks 2 run "$scene" "${small[@]}" --steps 2 --out "$out/float_1"
+[ "$status" -eq 2 ] || fail "a run into another run's folder on 2 ranks: status $status (want 2)"
+grep -q "swirl: error" "$out/stderr" || fail "a run into another run's folder: no error message"
+
+# 8. More ranks than particles: said before anything runs, status 2.
+on_ranks 4 run "$scene" --set particles.0.spacing=0.29 --steps 2 --out "$out/few"
+[ "$status" -eq 2 ] || fail "1 particle on 4 ranks: status $status (want 2)"
+grep -q "1 particles on 4 MPI ranks: every rank needs at least one particle" "$out/stderr" ||
+  fail "1 particle on 4 ranks: not said"
+
+[ "$failures" -eq 0 ] && echo "run_on_ranks: all checks passed"
+exit $((failures > 0))
