@@ -564,13 +564,16 @@ std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<R
                                 summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
 }
 
+// A text as bytes to send (no copy call for an empty one: its data may be null).
+dist::Bytes as_bytes(const std::string& text) {
+  const auto* first = reinterpret_cast<const std::byte*>(text.data());
+  return dist::Bytes(first, first + text.size());
+}
+
 // On several ranks: the checkpoint rank 0 chose (read_newest_checkpoint), read
 // by every other rank whole (Simulation::resume keeps its share).
 std::filesystem::path agree_on_path(const dist::Communicator& comm, const std::filesystem::path& mine) {
-  const std::string text = mine.string();
-  dist::Bytes bytes(text.size());
-  std::memcpy(bytes.data(), text.data(), text.size());
-  const std::vector<dist::Bytes> all = comm.all_gather(bytes);
+  const std::vector<dist::Bytes> all = comm.all_gather(as_bytes(mine.string()));
   return std::string(reinterpret_cast<const char*>(all[0].data()), all[0].size());
 }
 
@@ -586,9 +589,7 @@ struct Failure {
 Failure agree(const dist::Communicator& comm, const Failure& mine) {
   if (!comm.distributed()) return mine;
   const std::string text = mine.error.empty() ? std::string() : mine.blow_up + '\n' + mine.error;
-  dist::Bytes bytes(text.size());
-  std::memcpy(bytes.data(), text.data(), text.size());
-  for (const dist::Bytes& b : comm.all_gather(bytes)) {
+  for (const dist::Bytes& b : comm.all_gather(as_bytes(text))) {
     if (b.empty()) continue;
     const std::string all(reinterpret_cast<const char*>(b.data()), b.size());
     const auto cut = all.find('\n');

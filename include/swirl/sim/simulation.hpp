@@ -474,9 +474,8 @@ class Simulation {
     const std::uint64_t first = ranks_->first_global_index();
     std::string mine;
     if (index >= first && index < first + particles_.size()) mine = make(static_cast<std::size_t>(index - first));
-    dist::Bytes b(mine.size());
-    std::memcpy(b.data(), mine.data(), mine.size());
-    for (const dist::Bytes& part : ranks_->comm().all_gather(b))
+    const auto* text = reinterpret_cast<const std::byte*>(mine.data());
+    for (const dist::Bytes& part : ranks_->comm().all_gather(dist::Bytes(text, text + mine.size())))
       if (!part.empty()) return std::string(reinterpret_cast<const char*>(part.data()), part.size());
     return "?";
   }
