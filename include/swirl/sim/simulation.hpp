@@ -136,13 +136,13 @@ class Simulation {
   }
   // The rank order on several ranks, or null.
   const dist::RankOrder<Real>* ranks() const { return ranks_.get(); }
-  bool is_root() const { return !ranks_ || ranks_->comm().is_root(); }
   // Particles in the whole run (this rank's on one rank).
   std::uint64_t global_count() const { return ranks_ ? ranks_->global_count() : particles_.size(); }
 
   // The whole state in the one-rank memory order, for frames and checkpoints.
   // Collective on several ranks: there rank 0 gets every particle (gathered
-  // once per step and order) and the other ranks an empty set.
+  // once per step and order, and kept until the next gather: rank 0 holds a
+  // second copy of the whole set) and the other ranks an empty set.
   const ParticleSet<Real>& whole_particles() const {
     if (!ranks_) return particles_;
     const auto stamp = std::make_pair(clock_.step, epoch());
