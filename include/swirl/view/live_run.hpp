@@ -9,7 +9,9 @@
 //
 // Controls from the page act between steps: pause, resume, one step, reset
 // (the scene built again from its start), a speed cap, the field that colours
-// the particles, the mouse's push: an external force (PushForce, a solver
+// the particles, the surface (the fluid drawn as its surface mesh: made by a
+// Mesher, view/mesher.hpp, from the state copied for a frame, only while
+// some viewer has it on; SPH scenes only), the mouse's push: an external force (PushForce, a solver
 // like any other) a = strength·(v_drag − v)·(1 − r/R) on the particles within
 // R of the point, which drags the fluid along with the pointer, and the live
 // parameters (view/parameters.hpp: viscosity, gravity, softening), each change
@@ -28,6 +30,7 @@
 
 #include "swirl/scene/scene.hpp"
 #include "swirl/view/live_server.hpp"
+#include "swirl/view/mesher.hpp"
 
 namespace swirl::view {
 
@@ -36,6 +39,12 @@ struct ViewOptions {
   int threads = 0;        // worker threads of the simulation (0: OpenMP's default)
   double fps = 30;        // frames per second sent at most
   bool start_paused = false;
+  bool surface = false;       // every viewer starts with the surface on (SPH scenes and runs only)
+  // The surface mesh's grid cell, in particle spacings: coarser than a run's
+  // output.surface_cell (½), so that a mesh is made in a frame or two
+  // (docs/performance/view.md); its kernel radius and level are the scene's
+  // output.surface_radius and output.surface_iso.
+  double surface_cell = 1.0;
   const std::atomic<bool>* stop = nullptr;  // set (by a signal, or a test) to end the session
   std::function<void(const std::string&)> log;
   // Called once the server listens (the CLI prints the URL; tests connect).
@@ -52,9 +61,15 @@ struct ViewResult {
   std::uint64_t frames_read = 0;  // replay: frame files read (steps: frames shown)
   double read_seconds = 0;        // replay: time spent reading them
   ServerStats server;
+  MesherStats mesher;             // the surface meshes made (none unless a viewer turned the surface on)
 };
 
-// Runs until *options.stop; throws std::runtime_error when the server cannot listen.
+// The server's options of a session: options.server, new viewers starting
+// with the surface on when options.surface.
+ServerOptions server_options(const ViewOptions& options);
+
+// Runs until *options.stop; throws std::runtime_error when the server cannot
+// listen, std::invalid_argument for options.surface on a scene without [sph].
 ViewResult view_scene(const scene::Scene& scene, const ViewOptions& options);
 
 }  // namespace swirl::view
