@@ -5,13 +5,15 @@
 // state into a frame (view/wire.hpp) off the simulation's path; the server
 // (view/live_server.hpp) sends it. The simulation copies positions and the
 // coloured field only when the encoder is idle and a frame is due (fps), so a
-// viewer costs it one copy per frame and never a wait.
+// viewer costs it one copy per frame and never a wait. A fourth, the mesher
+// (view/mesher.hpp; SPH scenes), makes the fluid's surface mesh from the same
+// copy (with each particle's volume, copied then too) while some viewer has
+// the surface on and the mesher is free.
 //
 // Controls from the page act between steps: pause, resume, one step, reset
 // (the scene built again from its start), a speed cap, the field that colours
-// the particles, the surface (the fluid drawn as its surface mesh: made by a
-// Mesher, view/mesher.hpp, from the state copied for a frame, only while
-// some viewer has it on; SPH scenes only), the mouse's push: an external force (PushForce, a solver
+// the particles, the surface (on for a viewer: the surface of the state shown
+// now, also while paused), the mouse's push: an external force (PushForce, a solver
 // like any other) a = strength·(v_drag − v)·(1 − r/R) on the particles within
 // R of the point, which drags the fluid along with the pointer, and the live
 // parameters (view/parameters.hpp: viscosity, gravity, softening), each change
