@@ -4,6 +4,7 @@
 //   make browser-deps   # once: puppeteer-core into tests/browser/node_modules
 //   node tools/view_overhead.mjs [--swirl build/swirl] [--chromium /usr/bin/chromium]
 //        [--sizes 35000,1000000] [--seconds 20,60] [--rounds 3,2] [--threads 2] [--modes none,socket,chromium]
+//        [--surface-cell 1]
 //
 // For each size, the dam break (examples/dam_break.toml, the column's lattice
 // spacing set for about that many particles, dt = 1e-4 s at 10⁶ for its
@@ -14,12 +15,18 @@
 //   socket    a bare WebSocket client (Node's, --experimental-websocket: Node ≥ 20.10,
 //             so not Debian 12's Node 18; --modes none,chromium there) that
 //             receives the frames and counts their bytes: the server's side alone;
+//   surface   the socket client with the fluid's surface turned on (it sends
+//             the surface control, view/wire.hpp): swirl makes a mesh of the
+//             state copied for a frame whenever its mesher is free, and sends
+//             it; compared with socket, the cost of the surface;
 //   chromium  the page in headless Chromium on the same machine (WebGL2 on
 //             SwiftShader: software drawing, which competes for the cores).
 // The solver's speed is swirl's own "steps/s after the set-up" (its summary
 // line); the table gives each mode's median and its ratio to none's median,
 // the bytes per frame sent, and for chromium the page's median interval
-// between drawn frames (ms) and the frames it received per second.
+// between drawn frames (ms) and the frames it received per second, and for
+// surface the meshes made per second and swirl's mean time to make one
+// (mesh and encoding, on the mesher's thread; --surface-cell is passed on).
 import { spawn } from "node:child_process";
 import { createRequire } from "node:module";
 import os from "node:os";
@@ -38,6 +45,7 @@ const seconds = arg("seconds", "20,60").split(",").map(Number);
 const rounds = arg("rounds", "3,2").split(",").map(Number);
 const threads = arg("threads", "2");
 const modes = arg("modes", "none,socket,chromium").split(",");
+const surfaceCell = arg("surface-cell", "1");
 const { chromiumArgs } = { chromiumArgs: ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
   "--window-size=1280,800", "--mute-audio", "--no-first-run"] };  // as tests/browser/view_test.mjs
 const requireHarness = createRequire(path.join(root, "tests/browser/package.json"));
@@ -66,7 +74,7 @@ async function run(n, mode, secs) {
     browser = await puppeteer.launch({ executablePath: chromiumPath, headless: true, args: chromiumArgs,
       defaultViewport: { width: 1280, height: 800 } }), page = await browser.newPage(), children.add(browser.process());
   const swirl = spawn(swirlPath, ["view", path.join(root, "examples/dam_break.toml"), "--port", "0", "--seconds", String(secs),
-    "--threads", threads, ...o], { stdio: ["ignore", "pipe", "pipe"] });
+    "--threads", threads, "--surface-cell", surfaceCell, ...o], { stdio: ["ignore", "pipe", "pipe"] });
   children.add(swirl);
   let out = "", err = "";
   swirl.stdout.on("data", (d) => { out += d; });
@@ -75,9 +83,10 @@ async function run(n, mode, secs) {
   while (!/live at (\S+)/.test(out) && swirl.exitCode === null) await sleep(20);
   const url = (out.match(/live at (\S+)/) || [])[1];
   let client = null, clientDone = null, page_ = {};
-  if (mode === "socket") {
+  if (mode === "socket" || mode === "surface") {
     client = spawn(process.execPath, ["--experimental-websocket", "--no-warnings", "-e", `
       const ws = new WebSocket(${JSON.stringify(url.replace("http", "ws") + "ws")}); ws.binaryType = "arraybuffer";
+      if (${mode === "surface"}) ws.onopen = () => ws.send(new Uint8Array([10, 1]));  // the surface on
       let frames = 0, bytes = 0; ws.onmessage = (e) => { if (typeof e.data !== "string") { frames++; bytes += e.data.byteLength; } };
       ws.onclose = () => { console.log(JSON.stringify({ frames, bytes })); process.exit(0); };`], { stdio: ["ignore", "ignore", "inherit"] });
     children.add(client);
@@ -103,7 +112,10 @@ async function run(n, mode, secs) {
   if (clientDone) await clientDone;
   const m = out.match(/(\d+) steps in ([\d.]+) s \((\d+) resets; ([\d.]+) steps\/s after ([\d.]+) s of set-up\); (\d+) frames sent \(([\d.]+) MB\)/);
   if (!m) throw new Error(`no summary from swirl view: ${out}\n${err}`);
-  return { mode, steps: Number(m[1]), rate: Number(m[4]), setup: Number(m[5]), frames: Number(m[6]), mb: Number(m[7]), ...page_ };
+  const s = out.match(/; (\d+) surface meshes \(([\d.]+) ms a mesh, at most ([\d.]+); (\d+) vertices and (\d+) triangles the last\), (\d+) sent \(([\d.]+) MB\)/);
+  const surface = s ? { meshes: Number(s[1]), meshMs: Number(s[2]), meshMaxMs: Number(s[3]), vertices: Number(s[4]),
+    triangles: Number(s[5]), meshesSent: Number(s[6]), meshMb: Number(s[7]) } : {};
+  return { mode, steps: Number(m[1]), rate: Number(m[4]), setup: Number(m[5]), frames: Number(m[6]), mb: Number(m[7]), ...page_, ...surface };
 }
 
 console.log(`# swirl view overhead: ${os.cpus().length} × ${os.cpus()[0].model}, ${new Date().toISOString()}, threads ${threads}`);
@@ -118,17 +130,22 @@ for (let k = 0; k < sizes.length; k++) {
       all[mode].push(x);
       console.log(`  round ${r + 1} ${mode.padEnd(8)} ${x.rate.toFixed(3)} steps/s (${x.steps} steps, set-up ${x.setup} s), ` +
         `${x.frames} frames, ${x.frames ? ((x.mb * 1e6) / x.frames / 1e3).toFixed(1) : "-"} kB/frame` +
-        (x.frameMs !== undefined ? `, page: ${x.frameMs.toFixed(1)} ms/frame drawn, ${x.received_per_s.toFixed(1)} frames received/s` : ""));
+        (x.frameMs !== undefined ? `, page: ${x.frameMs.toFixed(1)} ms/frame drawn, ${x.received_per_s.toFixed(1)} frames received/s` : "") +
+        (x.meshes !== undefined ? `, surface: ${x.meshes} meshes (${(x.meshes / (x.steps / x.rate)).toFixed(1)}/s), ${x.meshMs} ms a mesh ` +
+          `(at most ${x.meshMaxMs}), ${x.vertices} vertices and ${x.triangles} triangles the last, ${x.meshesSent} sent, ` +
+          `${x.meshesSent ? (x.meshMb * 1e3 / x.meshesSent).toFixed(0) : "-"} kB/mesh` : ""));
     }
   const base = median(all[modes[0]].map((x) => x.rate));
-  console.log(`\n| mode | steps/s (median) | ratio to ${modes[0]} | frames sent/s | page frame time (median, ms) | frames received/s |`);
-  console.log("|---|---:|---:|---:|---:|---:|");
+  console.log(`\n| mode | steps/s (median) | ratio to ${modes[0]} | frames sent/s | page frame time (median, ms) | frames received/s | meshes/s | ms a mesh |`);
+  console.log("|---|---:|---:|---:|---:|---:|---:|---:|");
   for (const mode of modes) {
     const xs = all[mode], rate = median(xs.map((x) => x.rate));
     const fps = median(xs.map((x) => x.frames / (x.steps / x.rate)));
     const pf = xs[0].frameMs !== undefined ? median(xs.map((x) => x.frameMs)).toFixed(1) : "";
     const pr = xs[0].received_per_s !== undefined ? median(xs.map((x) => x.received_per_s)).toFixed(1) : "";
-    console.log(`| ${mode} | ${rate.toFixed(3)} | ${(rate / base).toFixed(3)} | ${fps.toFixed(1)} | ${pf} | ${pr} |`);
+    const ms = xs[0].meshes !== undefined ? median(xs.map((x) => x.meshes / (x.steps / x.rate))).toFixed(1) : "";
+    const mm = xs[0].meshes !== undefined ? median(xs.map((x) => x.meshMs)).toFixed(1) : "";
+    console.log(`| ${mode} | ${rate.toFixed(3)} | ${(rate / base).toFixed(3)} | ${fps.toFixed(1)} | ${pf} | ${pr} | ${ms} | ${mm} |`);
   }
   if (all.chromium && all.chromium[0].renderer) console.log(`\nrenderer: ${all.chromium[0].renderer}`);
 }

@@ -1,6 +1,8 @@
-// swirl view's page: decodes the server's frames (src/view/wire.cpp has the
-// layout), draws the particles as lit spheres (WebGL2 point-sprite impostors)
-// and sends the controls back. Written for swirl; no libraries.
+// swirl view's page: decodes the server's frames and surface meshes
+// (include/swirl/view/wire.hpp has the layouts), draws the particles as lit
+// spheres (WebGL2 point-sprite impostors) or the fluid as its surface (an
+// opaque water material) and sends the controls back. Written for swirl; no
+// libraries.
 "use strict";
 
 const token = new URLSearchParams(location.search).get("token");
@@ -14,6 +16,7 @@ const state = {
   yaw: 0.6, pitch: 0.35, distance: 3, target: [0, 0, 0], framed: false,
   paused: false, status: null, history: [], frames: 0, lastDraw: performance.now(), fps: 0,
   positions: null, frameMs: [], mode: "live", parameters: {}, note: "",
+  surface: false, mesh: null, meshes: 0, meshesRejected: 0, meshError: "",
 };
 // The test hook (tests/browser/view_test.mjs, tools/view_overhead.mjs) and the
 // console: window.swirlView is this state: hello (the server's hello), step and
@@ -24,7 +27,10 @@ const state = {
 // mode ("live" or "replay": then step is the frame's index in the run and
 // status.frame / status.frames say where the replay is), parameters (the live
 // parameters' current values by scene key, from the newest status) and note
-// (the last parameter change or refusal the server reported).
+// (the last parameter change or refusal the server reported); surface (the
+// "surface" box: the fluid drawn as its mesh), mesh (the newest mesh drawn:
+// step, time, vertices, triangles), meshes (mesh messages accepted) and
+// meshesRejected / meshError (those refused by the checks in onMesh, and why).
 // The camera (yaw, pitch, distance, target) may be set; worldAt(x, y) is global.
 window.swirlView = state;
 
@@ -99,7 +105,9 @@ function draw() {
   if (canvas.width !== w || canvas.height !== h) { canvas.width = w; canvas.height = h; }
   gl.viewport(0, 0, w, h);
   gl.clearColor(0.06, 0.08, 0.1, 1); gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
-  if (state.count > 0) {
+  // The surface instead of the particles once a mesh has come (until then, the particles).
+  if (state.surface && state.mesh) drawMesh(w, h);
+  else if (state.count > 0) {
     const gravity = state.hello && state.hello.gravity && !state.hello.sph;
     gl.useProgram(program);
     gl.uniformMatrix4fv(uni.view, false, lookAt());
@@ -113,6 +121,7 @@ function draw() {
     else { gl.enable(gl.DEPTH_TEST); gl.disable(gl.BLEND); }
     gl.bindVertexArray(vao);
     gl.drawArrays(gl.POINTS, 0, state.count);
+    gl.bindVertexArray(null);
   }
   const now = performance.now();
   state.fps = 0.9 * state.fps + 0.1 * (1000 / Math.max(1, now - state.lastDraw));
@@ -125,6 +134,82 @@ function draw() {
 function particleRadius() {  // half the mean spacing of the particles in their bounds
   const s = sub(state.hi, state.lo), vol = Math.max(s[0] * s[1] * s[2], 1e-30);
   return 0.5 * Math.cbrt(vol / Math.max(state.count, 1));
+}
+
+// ---- The water surface --------------------------------------------------------
+// An opaque water material, as swirl render --surface draws it (render/water.hpp):
+// a deep-blue Lambert body (35 % ambient), Schlick's Fresnel (F0 = 0.02) towards
+// a pale sky at grazing angles, a Blinn-Phong highlight, the light fixed to the
+// camera. Opaque so that the depth test alone orders the triangles (a
+// transparent surface would need them sorted every frame).
+const waterVs = `#version 300 es
+in vec3 q; in vec3 n;
+uniform mat4 view, proj; uniform vec3 lo, span;
+out vec3 normal; out vec3 where;
+void main() {
+  vec4 v = view * vec4(lo + q / 65535.0 * span, 1.0);
+  where = v.xyz; normal = mat3(view) * n;
+  gl_Position = proj * v;
+}`;
+const waterFs = `#version 300 es
+precision mediump float;
+in vec3 normal; in vec3 where; out vec4 outColor;
+void main() {
+  vec3 N = normalize(normal), V = normalize(-where), L = normalize(vec3(-0.35, 0.75, 0.55));
+  if (!gl_FrontFacing) N = -N;  // seen from inside the fluid
+  float body = 0.35 + 0.65 * max(dot(N, L), 0.0);
+  float fresnel = 0.02 + 0.98 * pow(1.0 - max(dot(N, V), 0.0), 5.0);
+  float highlight = 0.7 * pow(max(dot(N, normalize(L + V)), 0.0), 80.0);
+  vec3 c = (1.0 - fresnel) * vec3(0.02, 0.20, 0.40) * body + fresnel * vec3(0.72, 0.86, 0.96) + highlight;
+  outColor = vec4(min(c, vec3(1.0)), 1.0);
+}`;
+const water = gl.createProgram();
+gl.attachShader(water, compile(gl.VERTEX_SHADER, waterVs));
+gl.attachShader(water, compile(gl.FRAGMENT_SHADER, waterFs));
+gl.bindAttribLocation(water, 0, "q"); gl.bindAttribLocation(water, 1, "n");
+gl.linkProgram(water);
+const wuni = {};
+for (const n of ["view", "proj", "lo", "span"]) wuni[n] = gl.getUniformLocation(water, n);
+const meshVao = gl.createVertexArray(), mqbuf = gl.createBuffer(), mnbuf = gl.createBuffer(), mibuf = gl.createBuffer();
+gl.bindVertexArray(meshVao);
+gl.bindBuffer(gl.ARRAY_BUFFER, mqbuf); gl.enableVertexAttribArray(0); gl.vertexAttribPointer(0, 3, gl.UNSIGNED_SHORT, false, 0, 0);
+gl.bindBuffer(gl.ARRAY_BUFFER, mnbuf); gl.enableVertexAttribArray(1); gl.vertexAttribPointer(1, 3, gl.BYTE, true, 0, 0);
+gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, mibuf);  // part of the VAO's state
+gl.bindVertexArray(null);
+const meshGl = { count: 0, type: 0, lo: [0, 0, 0], span: [0, 0, 0] };
+
+// A mesh message ("SWVM"): every field checked before anything is drawn; a
+// message that fails a check is counted and dropped, the last good mesh stays.
+function onMesh(buffer) {
+  const dv = new DataView(buffer), reject = (why) => { state.meshesRejected++; state.meshError = why; };
+  if (buffer.byteLength < 64) return reject(`${buffer.byteLength} bytes, shorter than the header`);
+  if (dv.getUint16(4, true) !== 1) return reject(`version ${dv.getUint16(4, true)}`);
+  const b = dv.getUint16(6, true), v = dv.getUint32(24, true), t = dv.getUint32(28, true);
+  if (b !== 2 && b !== 4) return reject(`${b}-byte indices`);
+  if (b === 2 && v > 65536) return reject(`2-byte indices for ${v} vertices`);
+  if (buffer.byteLength !== 64 + 3 * b * t + 9 * v) return reject(`${buffer.byteLength} bytes for ${v} vertices, ${t} triangles`);
+  const lo = [0, 1, 2].map((a) => dv.getFloat32(32 + 4 * a, true)), hi = [0, 1, 2].map((a) => dv.getFloat32(44 + 4 * a, true));
+  if (![...lo, ...hi].every(Number.isFinite) || lo.some((x, a) => x > hi[a])) return reject("bounds not finite, or lo > hi");
+  const indices = b === 2 ? new Uint16Array(buffer, 64, 3 * t) : new Uint32Array(buffer, 64, 3 * t);
+  for (let k = 0; k < indices.length; k++) if (indices[k] >= v) return reject(`index ${indices[k]} of ${v} vertices`);
+  gl.bindVertexArray(null);
+  gl.bindBuffer(gl.ELEMENT_ARRAY_BUFFER, mibuf); gl.bufferData(gl.ELEMENT_ARRAY_BUFFER, indices, gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ARRAY_BUFFER, mqbuf); gl.bufferData(gl.ARRAY_BUFFER, new Uint16Array(buffer, 64 + 3 * b * t, 3 * v), gl.DYNAMIC_DRAW);
+  gl.bindBuffer(gl.ARRAY_BUFFER, mnbuf); gl.bufferData(gl.ARRAY_BUFFER, new Int8Array(buffer, 64 + 3 * b * t + 6 * v, 3 * v), gl.DYNAMIC_DRAW);
+  Object.assign(meshGl, { count: 3 * t, type: b === 2 ? gl.UNSIGNED_SHORT : gl.UNSIGNED_INT, lo, span: sub(hi, lo) });
+  state.mesh = { step: Number(dv.getBigUint64(8, true)), time: dv.getFloat64(16, true), vertices: v, triangles: t };
+  state.meshes++;
+}
+function drawMesh(w, h) {
+  gl.useProgram(water);
+  gl.uniformMatrix4fv(wuni.view, false, lookAt());
+  gl.uniformMatrix4fv(wuni.proj, false, perspective(0.8, w / h, state.distance * 0.01, state.distance * 100));
+  gl.uniform3fv(wuni.lo, meshGl.lo);
+  gl.uniform3fv(wuni.span, meshGl.span);
+  gl.enable(gl.DEPTH_TEST); gl.disable(gl.BLEND);
+  gl.bindVertexArray(meshVao);
+  gl.drawElements(gl.TRIANGLES, meshGl.count, meshGl.type, 0);
+  gl.bindVertexArray(null);
 }
 
 // ---- Frames and messages -------------------------------------------------------
@@ -162,13 +247,17 @@ function onText(text) {
     sel.value = m.colour;
     setPaused(m.paused);
     state.mode = m.mode || "live";
+    // The surface box: only where the server can make a surface (a fluid), ticked when it starts on (--surface).
+    ui("surfacelabel").style.display = m.surface ? "" : "none";
+    if (!m.surface) setSurface(false, false);
+    else if (m.surface_on) setSurface(true, false);
     if (state.mode === "replay") setUpReplay(m); else setUpParameters(m.parameters || []);
   } else if (m.type === "status") {
     state.status = m;
     setPaused(m.paused || m.at_end);
     if (m.mode === "replay") {
       ui("stats").textContent = `frame ${m.frame} of ${m.frames - 1} · t = ${Number(m.time).toPrecision(4)} · ` +
-        `${m.particles} particles · ${state.fps.toFixed(0)} fps` + (m.at_end ? " · last frame" : "");
+        `${m.particles} particles · ${state.fps.toFixed(0)} fps` + (m.at_end ? " · last frame" : "") + surfaceText(m);
       ui("frameinfo").textContent = `frame ${m.frame} / ${m.frames - 1} · t = ${Number(m.time).toPrecision(4)}`;
       // The slider follows the frame shown, but not while dragged or while a seek is on its way.
       if (seek && (m.frame === seek.frame || performance.now() - seek.at > 2000)) seek = null;
@@ -178,7 +267,7 @@ function onText(text) {
     state.history.push({ e: m.kinetic_energy + m.potential_energy, rate: m.steps_per_second });
     if (state.history.length > 240) state.history.shift();
     ui("stats").textContent = `step ${m.step} · t = ${Number(m.time).toPrecision(4)} · ${m.steps_per_second.toFixed(1)} steps/s · ` +
-      `${state.fps.toFixed(0)} fps` + (m.at_end ? " · end of run" : "");
+      `${state.fps.toFixed(0)} fps` + (m.at_end ? " · end of run" : "") + surfaceText(m);
     if (m.parameters) showParameters(m.parameters);
     plot();
   } else if (m.type === "error") {
@@ -186,6 +275,12 @@ function onText(text) {
   } else if (m.type === "parameter" || m.type === "refused") {
     state.note = m.message; ui("note").textContent = m.message.replace(/^swirl view: /, "");
   }
+}
+
+// The surface's figures in the stats line, while it is on: the newest mesh and the server's time a mesh.
+function surfaceText(m) {
+  if (!state.surface || !state.mesh || !m.surface) return "";
+  return ` · surface ${state.mesh.triangles} triangles, ${Number(m.surface.ms).toFixed(0)} ms a mesh`;
 }
 
 // ---- Replay: the time slider ------------------------------------------------------------
@@ -293,12 +388,19 @@ function sendPush(point, velocity, on) {
   values.forEach((v, i) => b.setFloat32(1 + 4 * i, v, true));
   b.setUint8(33, on ? 1 : 0); send(b.buffer);
 }
+// The surface on or off: the box, the drawing, and (send) the server, which makes meshes only while someone wants them.
+function setSurface(on, tell) {
+  state.surface = on; ui("surface").checked = on;
+  if (!on) state.mesh = null;  // a mesh kept from before would be stale when turned on again
+  if (tell) send(new Uint8Array([10, on ? 1 : 0]));
+}
 function setPaused(p) { state.paused = p; ui("play").textContent = p ? "play" : "pause"; }
 ui("play").onclick = () => { sendKind(state.paused ? 2 : 1); setPaused(!state.paused); };
 ui("step").onclick = () => sendKind(3);
 ui("reset").onclick = () => { sendKind(4); ui("message").style.display = "none"; };
 ui("speed").onchange = (e) => sendSpeed(Number(e.target.value));
 ui("colour").onchange = (e) => sendColour(Number(e.target.value));
+ui("surface").onchange = (e) => setSurface(e.target.checked, true);
 
 // ---- Mouse: orbit, pan, zoom, push -----------------------------------------------------
 let drag = null;
@@ -342,7 +444,12 @@ canvas.addEventListener("wheel", (ev) => { ev.preventDefault(); state.distance *
 function connect() {
   const url = `${location.protocol === "https:" ? "wss" : "ws"}://${location.host}/ws` + (token ? `?token=${encodeURIComponent(token)}` : "");
   socket = new WebSocket(url); socket.binaryType = "arraybuffer";
-  socket.onmessage = (ev) => (typeof ev.data === "string" ? onText(ev.data) : onFrame(ev.data));
+  socket.onmessage = (ev) => {
+    if (typeof ev.data === "string") return onText(ev.data);
+    const magic = ev.data.byteLength >= 4 ? new DataView(ev.data).getUint32(0, true) : 0;
+    if (magic === 0x4D565753) onMesh(ev.data);  // "SWVM"
+    else onFrame(ev.data);                       // "SWVF" (checked there)
+  };
   socket.onclose = () => { ui("stats").textContent = "disconnected: the run has ended (reload to reconnect)"; };
 }
 connect();

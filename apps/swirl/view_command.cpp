@@ -39,6 +39,8 @@ struct ViewArgs {
   int threads = 0;
   double fps = 30;
   bool paused = false;
+  bool surface = false;      // viewers start with the fluid's surface on
+  double surface_cell = 1.0;  // the view's surface grid cell, particle spacings
   double seconds = 0;  // stop after this many wall seconds (0: run until Ctrl-C)
   std::string format = "auto";  // replay: the frames to read (auto, vtp, h5)
 };
@@ -76,6 +78,8 @@ int view(const ViewArgs& args) {
   options.threads = args.threads;
   options.fps = args.fps;
   options.start_paused = args.paused;
+  options.surface = args.surface;
+  options.surface_cell = args.surface_cell;
   options.stop = &g_view_stop;
   options.log = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
   options.on_listening = [&](const view::LiveServer& server) {
@@ -112,21 +116,31 @@ int view(const ViewArgs& args) {
     JoinTimer join{timer};
     r = replay ? view::replay_run(*run, options) : view::view_scene(*scene, options);
   }
+  // The surface meshes, when a viewer asked for them (tools/view_overhead.mjs reads this line too).
+  const std::string meshes =
+      r.mesher.meshes + r.mesher.failed == 0
+          ? std::string()
+          : fmt::format("; {} surface meshes ({:.1f} ms a mesh, at most {:.1f}; {} vertices and {} triangles the last), "
+                        "{} sent ({:.1f} MB){}",
+                        r.mesher.meshes, r.mesher.meshes ? 1e3 * r.mesher.seconds / double(r.mesher.meshes) : 0.0,
+                        1e3 * r.mesher.max_seconds, r.mesher.vertices, r.mesher.triangles, r.server.meshes_sent,
+                        double(r.server.mesh_bytes_sent) / 1e6,
+                        r.mesher.failed ? fmt::format(", {} not made", r.mesher.failed) : std::string());
   if (replay) {
     fmt::print("swirl view: {} frames shown in {:.1f} s; {} frames read, {:.1f} ms a frame; {} frames sent ({:.1f} MB), "
-               "{} controls, {} dropped, {} refused, {} viewers\n",
+               "{} controls, {} dropped, {} refused, {} viewers{}\n",
                r.steps, r.wall_seconds, r.frames_read, r.frames_read ? 1e3 * r.read_seconds / double(r.frames_read) : 0.0,
                r.server.frames_sent, double(r.server.bytes_sent) / 1e6, r.server.controls, r.server.dropped, r.refused,
-               r.server.sessions);
+               r.server.sessions, meshes);
     return 0;
   }
   // steps/s over the session after the set-up (tools/view_overhead.mjs reads this line).
   const double stepping = r.wall_seconds - r.setup_seconds;
   fmt::print("swirl view: {} steps in {:.1f} s ({} resets; {:.2f} steps/s after {:.1f} s of set-up); {} frames sent ({:.1f} MB), "
-             "{} controls, {} dropped, {} viewers; {} parameter changes, {} refused\n",
+             "{} controls, {} dropped, {} viewers; {} parameter changes, {} refused{}\n",
              r.steps, r.wall_seconds, r.resets, stepping > 0 ? double(r.steps) / stepping : 0.0, r.setup_seconds,
              r.server.frames_sent, double(r.server.bytes_sent) / 1e6, r.server.controls, r.server.dropped, r.server.sessions,
-             r.parameter_changes, r.refused);
+             r.parameter_changes, r.refused, meshes);
   return 0;
 }
 
@@ -142,6 +156,11 @@ void add_view_command(CLI::App& app, Commands& commands) {
   cmd->add_option("--threads", args->threads, "Worker threads of the simulation (0: all cores)")->check(CLI::NonNegativeNumber);
   cmd->add_option("--fps", args->fps, "Frames per second sent at most")->check(CLI::Range(0.1, 240.0));
   cmd->add_flag("--paused", args->paused, "Start paused");
+  cmd->add_flag("--surface", args->surface,
+                "Viewers start with the fluid drawn as its surface (SPH scenes and runs; the page's \"surface\" box)");
+  cmd->add_option("--surface-cell", args->surface_cell,
+                  "The surface mesh's grid cell in particle spacings (finer: smoother, slower to make and send)")
+      ->check(CLI::Range(0.05, 4.0));
   cmd->add_option("--format", args->format, "Replay: the frames to read, vtp (particles.pvd) or h5 (snapshots); auto: vtp when present")
       ->check(CLI::IsMember({"auto", "vtp", "h5"}));
   cmd->add_option("--seconds", args->seconds, "End the session after this many wall-clock seconds (0: at Ctrl-C)")

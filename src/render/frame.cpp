@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/io/vtp.hpp"
@@ -73,6 +74,8 @@ Frame load_snapshot_frame(const std::filesystem::path& file) {
   };
   scalar("Density", f.density);
   scalar("Pressure", f.pressure);
+  if (const auto it = s.datasets.find(std::string(kKindField)); it != s.datasets.end() && it->second.columns == 1)
+    for (const double k : it->second.values) f.kind.push_back(static_cast<std::int32_t>(k));
   return f;
 }
 }  // namespace
@@ -96,6 +99,14 @@ Frame load_frame(const std::filesystem::path& file) {
   scalar("mass", f.mass);
   scalar("density", f.density);
   scalar("pressure", f.pressure);
+  if (auto it = vtp.point_data.find(std::string(kKindField)); it != vtp.point_data.end()) {
+    if (it->second.type != "Int32" || it->second.components != 1)
+      throw io::IoError(file.string() + ": array 'kind' is " + it->second.type + ", expected Int32");
+    f.kind = it->second.values<std::int32_t>();
+    if (f.kind.size() != n)
+      throw io::IoError(file.string() + ": array 'kind' has " + std::to_string(f.kind.size()) + " values for " +
+                        std::to_string(n) + " points");
+  }
   for (const Vec3d& p : f.positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw io::IoError(file.string() + ": a particle position is not finite");

@@ -597,8 +597,10 @@ std::vector<SceneKey> declare_scene_keys() {
   // The surface keys change files beside the frames, never the run: not hashed.
   add(field(SceneKey{.key = "output.surface", .section = "output", .noun = "surface format",
                      .doc = "`\"ply\"` writes the fluid's surface with each frame, `surface_NNNNNN.ply` (binary "
-                            "triangle mesh with normals, for Blender and ParaView; series in `surface.ply.series`); "
-                            "needs `[sph]` and a `\"vtp\"` or `\"hdf5\"` frame format (docs/surface.md)",
+                            "triangle mesh with normals, for Blender and ParaView; series in `surface.ply.series`), "
+                            "`\"obj\"` as `surface_NNNNNN.obj` (Wavefront OBJ text, no series: ParaView's OBJ reader "
+                            "takes one file); needs `[sph]` and a `\"vtp\"` or `\"hdf5\"` frame format "
+                            "(docs/surface.md)",
                      .hashed = false},
             in_scene(&Scene::surface)));
   add(field(SceneKey{.key = "output.surface_radius", .section = "output", .unit = "particle spacings",

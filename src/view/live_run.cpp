@@ -14,7 +14,9 @@
 #include <fmt/format.h>
 
 #include "json.hpp"
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/parallel/for_blocks.hpp"
+#include "swirl/render/fluid_surface.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/view/parameters.hpp"
 #include "swirl/view/push_force.hpp"
@@ -53,8 +55,15 @@ class LiveSession {
         options_(options),
         paused_(options.start_paused),
         server_(
-            options.server, [this](const Control& c) { receive(c); }, [this] { return hello(); },
-            options.log) {}
+            server_options(options), [this](const Control& c) { receive(c); }, [this] { return hello(); },
+            options.log) {
+    if (scene_.sph) {  // the surface is an SPH fluid's
+      render::FluidSurface settings = render::fluid_surface_of(scene_);
+      settings.cell = options.surface_cell;
+      mesher_ = std::make_unique<Mesher>(
+          settings, [this](std::shared_ptr<const std::string> m) { server_.publish_mesh(std::move(m)); }, options.log);
+    }
+  }
   // The server's thread calls hello(): it only reads the text the simulation's thread left.
   std::string hello() {
     std::lock_guard lock(hello_mutex_);
@@ -71,6 +80,7 @@ class LiveSession {
     copy_frame(true);
     while (!(options_.stop && options_.stop->load())) {
       apply_controls();
+      watch_surface_viewers();
       const bool step_once = (paused_ && !at_end_ && pending_steps_ > 0);
       if (step_once) --pending_steps_;
       if ((paused_ || at_end_) && !step_once) {
@@ -95,8 +105,14 @@ class LiveSession {
     }
     frame_cv_.notify_all();
     encoder.join();
+    MesherStats meshes;
+    if (mesher_) {
+      meshes = mesher_->stats();
+      mesher_.reset();  // finishes the mesh being made (it publishes to the server, still running)
+    }
     server_.stop();
     ViewResult r;
+    r.mesher = meshes;
     r.steps = steps_;
     r.resets = resets_;
     r.parameter_changes = changes_;
@@ -239,10 +255,23 @@ class LiveSession {
         if (k->field < fields_.size()) colour_ = k->field, recolour_ = true, refresh_hello();
       } else if (const auto* v = std::get_if<control::Parameter>(&c)) {
         set_parameter(*v);
+      } else if (const auto* surface = std::get_if<control::Surface>(&c)) {
+        // The server keeps who wants meshes (watch_surface_viewers acts on it).
+        if (!mesher_ && surface->on) refuse("the surface is an SPH fluid's, and this scene has no [sph]");
       } else if (std::holds_alternative<control::Seek>(c)) {
         refuse("seek is for a replay (swirl view RUN_DIR), not a live run");
       }
     }
+  }
+
+  // A viewer who turned the surface on, or came with it on (--surface), gets
+  // the surface of the state shown now, also while paused: a new state copy,
+  // which offers the mesher its state.
+  void watch_surface_viewers() {
+    if (!mesher_) return;
+    const std::size_t viewers = server_.surface_viewers();
+    if (viewers > surface_viewers_) recolour_ = true;
+    surface_viewers_ = viewers;
   }
 
   // On the server's thread: a push goes straight to the force; the rest waits for the next step boundary.
@@ -271,10 +300,10 @@ class LiveSession {
       box = fmt::format("[{},{},{},{},{},{}]", scene_.box.lo.x, scene_.box.lo.y, scene_.box.lo.z, scene_.box.hi.x,
                         scene_.box.hi.y, scene_.box.hi.z);
     std::string text = fmt::format(
-        R"({{"type":"hello","mode":"live","scene":{},"particles":{},"fields":[{}],"colour":{},"box":{},"gravity":{},"sph":{},"paused":{},"parameters":{}}})",
+        R"({{"type":"hello","mode":"live","scene":{},"particles":{},"fields":[{}],"colour":{},"box":{},"gravity":{},"sph":{},"paused":{},"parameters":{},"surface":{},"surface_on":{}}})",
         json::string(scene_.file), sim_ ? sim_->particles().size() : 0, fields, colour_.load(), box,
         scene_.nbody ? "true" : "false", scene_.sph ? "true" : "false", paused_ ? "true" : "false",
-        parameters_json(parameters_));
+        parameters_json(parameters_), json::boolean(mesher_ != nullptr), json::boolean(mesher_ && options_.surface));
     std::lock_guard lock(hello_mutex_);
     hello_ = std::move(text);
   }
@@ -307,9 +336,10 @@ class LiveSession {
     double potential = 0;
     for (const auto& s : sim_->solvers()) potential += s->potential_energy(p, sim_->settings().block_size);
     return fmt::format(
-        R"({{"type":"status","mode":"live","step":{},"time":{},"steps_per_second":{},"paused":{},"at_end":{},"kinetic_energy":{},"potential_energy":{},"parameters":{}}})",
+        R"({{"type":"status","mode":"live","step":{},"time":{},"steps_per_second":{},"paused":{},"at_end":{},"kinetic_energy":{},"potential_energy":{},"parameters":{},"surface":{}}})",
         sim_->step_count(), json::number(sim_->time()), json::number(rate), paused_ ? "true" : "false",
-        at_end_ ? "true" : "false", json::number(kinetic), json::number(potential), parameter_values_json(parameters_));
+        at_end_ ? "true" : "false", json::number(kinetic), json::number(potential), parameter_values_json(parameters_),
+        mesher_json(mesher_.get()));
   }
 
   // Copies the state for the encoder when it is idle and a frame is due (or forced).
@@ -325,7 +355,8 @@ class LiveSession {
     }
     const auto& p = sim_->particles();
     const std::size_t n = p.size();
-    FrameData f;
+    auto frame = std::make_shared<FrameData>();
+    FrameData& f = *frame;
     f.step = sim_->step_count();
     f.time = sim_->time();
     f.x.resize(n), f.y.resize(n), f.z.resize(n);
@@ -359,9 +390,27 @@ class LiveSession {
         case Colouring::Int: f.colour[i] = float(p.int_field(c.index)[i]); break;
       }
     }
+    // The surface's state: this frame's positions and the fluid's volumes,
+    // when some viewer wants a mesh and the mesher is free (or a forced
+    // frame's state, which waits for the mesher).
+    std::optional<MeshInput> mesh;
+    if (mesher_ && server_.surface_viewers() > 0 && (force || !mesher_->busy())) {
+      mesh.emplace();
+      mesh->volumes.resize(n);
+      const double rho0 = scene_.sph->rest_density;
+      const std::size_t k = p.find_int_field(kKindField);
+      const std::int32_t* kind = k == ParticleSet<Real>::npos ? nullptr : p.int_field(k).data();
+      for (std::size_t i = 0; i < n; ++i)
+        mesh->volumes[i] = kind && is_boundary(kind[i]) ? 0.0 : double(p.mass[i]) / rho0;
+    }
+    std::shared_ptr<const FrameData> shared = std::move(frame);
+    if (mesh) {
+      mesh->frame = shared;
+      mesher_->offer(std::move(*mesh));
+    }
     {
       std::lock_guard lock(frame_mutex_);
-      pending_ = std::move(f);
+      pending_ = std::move(shared);
       encoder_busy_ = true;
       last_frame_ = now;
     }
@@ -370,15 +419,14 @@ class LiveSession {
 
   void encode_loop() {
     for (;;) {
-      FrameData f;
+      std::shared_ptr<const FrameData> f;
       {
         std::unique_lock lock(frame_mutex_);
         frame_cv_.wait(lock, [this] { return quit_ || pending_; });
         if (quit_) return;
-        f = std::move(*pending_);
-        pending_.reset();
+        f = std::move(pending_);
       }
-      server_.publish(std::make_shared<const std::string>(encode_frame(f)));
+      server_.publish(std::make_shared<const std::string>(encode_frame(*f)));
       bool again = false;
       {
         std::lock_guard lock(frame_mutex_);
@@ -401,6 +449,7 @@ class LiveSession {
   std::vector<Colouring> fields_;
   std::atomic<std::size_t> colour_{0};
   std::atomic<bool> recolour_{false};
+  std::size_t surface_viewers_ = 0;  // as last seen by watch_surface_viewers
   bool paused_ = false, at_end_ = false;
   float speed_ = 0;
   std::uint64_t steps_ = 0, resets_ = 0, status_steps_ = 0, pending_steps_ = 0;
@@ -412,18 +461,28 @@ class LiveSession {
 
   std::mutex frame_mutex_;
   std::condition_variable frame_cv_;
-  std::optional<FrameData> pending_;
+  std::shared_ptr<const FrameData> pending_;  // shared with the mesher, which may still read it
   bool encoder_busy_ = false, quit_ = false, missed_ = false;
   Clock::time_point last_frame_{};
 
   LiveServer server_;
+  std::unique_ptr<Mesher> mesher_;  // SPH scenes only; after server_, so that it stops first
 };
 
 }  // namespace
 
+ServerOptions server_options(const ViewOptions& options) {
+  ServerOptions s = options.server;
+  s.surface_on_connect = options.surface;
+  return s;
+}
+
 ViewResult view_scene(const scene::Scene& scene, const ViewOptions& options) {
-  if (options.threads > 0) parallel::set_thread_count(options.threads);
   if (!(options.fps > 0)) throw std::invalid_argument("swirl view: fps must be > 0");
+  if (options.surface && !scene.sph)
+    throw std::invalid_argument(fmt::format("swirl view: --surface draws an SPH fluid's surface, and {} has no [sph]",
+                                            scene.file));
+  if (options.threads > 0) parallel::set_thread_count(options.threads);
   if (scene.precision == scene::Precision::Float) return LiveSession<float>(scene, options).run();
   return LiveSession<double>(scene, options).run();
 }

@@ -5,6 +5,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <thread>
+#include <variant>
 #include <utility>  // before Boost 1.74's asio, which uses std::exchange without it
 #include <vector>
 
@@ -57,14 +58,28 @@ struct LiveServer::Impl {
   std::thread thread;
   std::uint16_t bound_port = 0;
 
-  std::mutex mutex;  // latest, latest_seq, texts_seq
+  std::mutex mutex;  // latest, latest_seq, mesh, mesh_seq
   std::shared_ptr<const std::string> latest;
   std::uint64_t latest_seq = 0;
+  std::shared_ptr<const std::string> mesh;  // the newest surface mesh; null while nobody wants one
+  std::uint64_t mesh_seq = 0;
+  std::atomic<std::size_t> surface_viewers{0};  // changed on the I/O thread only
 
   class WsSession;
   std::vector<std::weak_ptr<WsSession>> sessions;  // the I/O thread's only
 
   std::atomic<std::uint64_t> frames_sent{0}, bytes_sent{0}, controls{0}, dropped{0}, session_count{0};
+  std::atomic<std::uint64_t> meshes_sent{0}, mesh_bytes_sent{0};
+
+  // A viewer's surface turned on or off (on the I/O thread).
+  void count_surface(bool on) {
+    if (on) {
+      ++surface_viewers;
+    } else if (--surface_viewers == 0) {
+      std::lock_guard lock(mutex);
+      mesh.reset();
+    }
+  }
 
   void say(const std::string& line) {
     if (log) log(line);
@@ -96,6 +111,7 @@ struct LiveServer::Impl {
         if (ec) return;
         ++self->server_.session_count;
         self->server_.sessions.push_back(self);
+        self->set_surface(self->server_.options.surface_on_connect);
         self->texts_.push_back(self->server_.hello ? self->server_.hello() : std::string("{}"));
         self->pump();
         self->read();
@@ -107,7 +123,15 @@ struct LiveServer::Impl {
       pump();
     }
 
-    // Writes the next text, else the newest frame not yet sent, unless a write is in flight.
+    // This viewer's surface on or off (counted by the server while the session lives).
+    void set_surface(bool on) {
+      if (on == surface_) return;
+      surface_ = on;
+      server_.count_surface(on);
+    }
+
+    // Writes the next text, else the newest frame or mesh not yet sent (the
+    // one not sent last when both are new), unless a write is in flight.
     void pump() {
       if (writing_ || closed_) return;
       auto self = shared_from_this();
@@ -116,41 +140,64 @@ struct LiveServer::Impl {
         texts_.pop_front();
         writing_ = true;
         ws_.text(true);
-        ws_.async_write(net::buffer(text_), [self](beast::error_code ec, std::size_t) { self->written(ec, 0); });
+        ws_.async_write(net::buffer(text_), [self](beast::error_code ec, std::size_t) { self->written(ec, 0, false); });
         return;
       }
+      bool mesh = false;
       {
         std::lock_guard lock(server_.mutex);
-        if (!server_.latest || server_.latest_seq == sent_seq_) return;
-        frame_ = server_.latest;
-        sent_seq_ = server_.latest_seq;
+        const bool new_frame = server_.latest && server_.latest_seq != sent_seq_;
+        const bool new_mesh = surface_ && server_.mesh && server_.mesh_seq != sent_mesh_seq_;
+        if (!new_frame && !new_mesh) return;
+        mesh = new_mesh && (!new_frame || last_was_frame_);
+        if (mesh) {
+          binary_ = server_.mesh;
+          sent_mesh_seq_ = server_.mesh_seq;
+        } else {
+          binary_ = server_.latest;
+          sent_seq_ = server_.latest_seq;
+        }
       }
+      last_was_frame_ = !mesh;
       writing_ = true;
       ws_.binary(true);
-      ws_.async_write(net::buffer(*frame_),
-                      [self](beast::error_code ec, std::size_t n) { self->written(ec, n); });
+      ws_.async_write(net::buffer(*binary_),
+                      [self, mesh](beast::error_code ec, std::size_t n) { self->written(ec, n, mesh); });
     }
 
    private:
-    void written(beast::error_code ec, std::size_t frame_bytes) {
+    void written(beast::error_code ec, std::size_t binary_bytes, bool mesh) {
       writing_ = false;
       if (ec) {
-        closed_ = true;
+        mark_closed();
         return;
       }
-      if (frame_bytes > 0) {
-        ++server_.frames_sent;
-        server_.bytes_sent += frame_bytes;
-        frame_.reset();
+      if (binary_bytes > 0) {
+        if (mesh) {
+          ++server_.meshes_sent;
+          server_.mesh_bytes_sent += binary_bytes;
+        } else {
+          ++server_.frames_sent;
+          server_.bytes_sent += binary_bytes;
+        }
+        binary_.reset();
       }
       pump();
+    }
+
+    // The session is over: it no longer wants meshes. (Here, on a failed read
+    // or write, which every closed connection ends in, and not in a
+    // destructor, which may run while the server's state is torn down.)
+    void mark_closed() {
+      closed_ = true;
+      set_surface(false);
     }
 
     void read() {
       auto self = shared_from_this();
       ws_.async_read(buffer_, [self](beast::error_code ec, std::size_t) {
         if (ec) {
-          self->closed_ = true;
+          self->mark_closed();
           if (ec == websocket::error::message_too_big)
             self->server_.drop(fmt::format("a message over {} bytes; session closed", self->server_.options.max_message));
           return;
@@ -161,6 +208,7 @@ struct LiveServer::Impl {
         self->buffer_.consume(self->buffer_.size());
         if (parsed.control) {
           ++self->server_.controls;
+          if (const auto* surface = std::get_if<control::Surface>(&*parsed.control)) self->set_surface(surface->on);
           if (self->server_.on_control) self->server_.on_control(*parsed.control);
         } else {
           self->server_.drop(parsed.error);
@@ -174,9 +222,9 @@ struct LiveServer::Impl {
     beast::flat_buffer buffer_;
     std::deque<std::string> texts_;
     std::string text_;
-    std::shared_ptr<const std::string> frame_;
-    std::uint64_t sent_seq_ = 0;
-    bool writing_ = false, closed_ = false;
+    std::shared_ptr<const std::string> binary_;  // the frame or mesh being written
+    std::uint64_t sent_seq_ = 0, sent_mesh_seq_ = 0;
+    bool writing_ = false, closed_ = false, surface_ = false, last_was_frame_ = false;
   };
 
   class HttpSession : public std::enable_shared_from_this<HttpSession> {
@@ -295,6 +343,18 @@ void LiveServer::publish(std::shared_ptr<const std::string> frame) {
   net::post(impl_->ioc, [this] { impl_->pump_all(); });
 }
 
+void LiveServer::publish_mesh(std::shared_ptr<const std::string> mesh) {
+  {
+    std::lock_guard lock(impl_->mutex);
+    if (impl_->surface_viewers.load() == 0) return;  // nobody wants it (any more)
+    impl_->mesh = std::move(mesh);
+    ++impl_->mesh_seq;
+  }
+  net::post(impl_->ioc, [this] { impl_->pump_all(); });
+}
+
+std::size_t LiveServer::surface_viewers() const { return impl_->surface_viewers.load(); }
+
 void LiveServer::announce(std::string text) {
   net::post(impl_->ioc, [this, text = std::move(text)] {
     std::erase_if(impl_->sessions, [](const auto& s) { return s.expired(); });
@@ -305,7 +365,7 @@ void LiveServer::announce(std::string text) {
 
 ServerStats LiveServer::stats() const {
   return {impl_->frames_sent.load(), impl_->bytes_sent.load(), impl_->controls.load(), impl_->dropped.load(),
-          impl_->session_count.load()};
+          impl_->session_count.load(), impl_->meshes_sent.load(), impl_->mesh_bytes_sent.load()};
 }
 
 }  // namespace swirl::view

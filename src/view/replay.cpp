@@ -14,11 +14,13 @@
 #include <fmt/format.h>
 
 #include "json.hpp"
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/pvd.hpp"
 #include "swirl/io/read_file.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/io/vtp.hpp"
+#include "swirl/render/fluid_surface.hpp"
 #include "swirl/scene/load.hpp"
 
 namespace swirl::view {
@@ -177,6 +179,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+// The value of a frame's field by name, or null.
+const std::vector<float>* field(const ReplayFrame& f, std::string_view name) {
+  for (const auto& [n, values] : f.fields)
+    if (n == name && values.size() == f.x.size()) return &values;
+  return nullptr;
+}
+
 class ReplaySession {
  public:
   ReplaySession(const RunFrames& run, const ViewOptions& options)
@@ -184,7 +193,7 @@ class ReplaySession {
         options_(options),
         playing_(!options.start_paused),
         server_(
-            options.server, [this](const Control& c) { receive(c); },
+            server_options(options), [this](const Control& c) { receive(c); },
             [this] {
               std::lock_guard lock(hello_mutex_);
               return hello_;
@@ -197,6 +206,21 @@ class ReplaySession {
     index_ = 0;
     fields_.clear();
     for (const auto& [name, values] : current_.fields) fields_.push_back(name);
+    // The surface: a fluid's run whose frames have the masses (and, without
+    // the scene's ρ0, the densities) that give each particle its volume.
+    const scene::Scene* s = run_.scene ? &*run_.scene : nullptr;
+    rest_density_ = s && s->sph ? s->sph->rest_density : 0.0;
+    if (is_fluid() && field(current_, "mass") && (rest_density_ > 0 || field(current_, "density"))) {
+      render::FluidSurface settings = s ? render::fluid_surface_of(*s) : render::FluidSurface{};
+      settings.rest_density = rest_density_;
+      settings.cell = options_.surface_cell;
+      mesher_ = std::make_unique<Mesher>(
+          settings, [this](std::shared_ptr<const std::string> m) { server_.publish_mesh(std::move(m)); }, options_.log);
+    } else if (options_.surface) {
+      throw std::invalid_argument(fmt::format(
+          "swirl view: --surface draws a fluid's surface, and {} is {}", run_.dir.string(),
+          is_fluid() ? "a fluid's run whose frames have no masses (or densities)" : "not a fluid's run"));
+    }
     refresh_hello();
     const auto t_ready = Clock::now();
     server_.start();
@@ -205,6 +229,12 @@ class ReplaySession {
     next_due_ = Clock::now() + period();
     while (!(options_.stop && options_.stop->load())) {
       apply_controls();
+      // A viewer who turned the surface on, or came with it on (--surface): the frame shown again, with its surface.
+      if (mesher_) {
+        const std::size_t viewers = server_.surface_viewers();
+        if (viewers > surface_viewers_) publish();
+        surface_viewers_ = viewers;
+      }
       if (playing_ && Clock::now() >= next_due_) {
         if (index_ + 1 < run_.frames.size()) {
           show(index_ + 1);
@@ -221,8 +251,12 @@ class ReplaySession {
                                   : Clock::now() + std::chrono::milliseconds(50);
       wake_.wait_until(lock, until, [this] { return !controls_.empty(); });
     }
-    server_.stop();
     ViewResult r;
+    if (mesher_) {
+      r.mesher = mesher_->stats();
+      mesher_.reset();  // finishes the mesh being made (it publishes to the server, still running)
+    }
+    server_.stop();
     r.steps = shown_;
     r.refused = refused_;
     r.frames_read = frames_read_;
@@ -267,7 +301,8 @@ class ReplaySession {
   }
 
   void publish() {
-    FrameData f;
+    auto frame = std::make_shared<FrameData>();
+    FrameData& f = *frame;
     f.step = index_;
     f.time = run_.frames[index_].time;
     f.x = current_.x, f.y = current_.y, f.z = current_.z;
@@ -293,8 +328,32 @@ class ReplaySession {
           f.colour_field = std::uint16_t(colour_);
         }
     server_.publish(std::make_shared<const std::string>(encode_frame(f)));
+    if (mesher_ && server_.surface_viewers() > 0) offer_mesh(std::move(frame));
     ++shown_;
     server_.announce(status());
+  }
+
+  // The frame's state for the mesher: each particle's volume m/ρ0 (m/ρ
+  // without the scene's ρ0), 0 for a boundary particle (left out).
+  void offer_mesh(std::shared_ptr<const FrameData> frame) {
+    const std::vector<float>* mass = field(current_, "mass");
+    const std::vector<float>* density = field(current_, "density");
+    if (!mass || (rest_density_ <= 0 && !density)) return;  // a later frame without them: no surface for it
+    const std::vector<float>* kind = field(current_, kKindField);
+    MeshInput input;
+    input.volumes.resize(mass->size());
+    for (std::size_t i = 0; i < mass->size(); ++i) {
+      const double rho = rest_density_ > 0 ? rest_density_ : double((*density)[i]);
+      input.volumes[i] = (kind && is_boundary(std::int32_t((*kind)[i]))) || !(rho > 0) ? 0.0 : double((*mass)[i]) / rho;
+    }
+    input.frame = std::move(frame);
+    mesher_->offer(std::move(input));
+  }
+
+  // A fluid's run: its scene says so, or (without one) its frames have a pressure.
+  bool is_fluid() const {
+    if (run_.scene) return run_.scene->sph.has_value();
+    return std::find(fields_.begin(), fields_.end(), "pressure") != fields_.end();
   }
 
   void apply_controls() {
@@ -328,6 +387,10 @@ class ReplaySession {
         refuse("the push acts on a live run, not a replay");
       } else if (std::holds_alternative<control::Parameter>(c)) {
         refuse("live parameters act on a live run, not a replay");
+      } else if (const auto* surface = std::get_if<control::Surface>(&c)) {
+        // The server keeps who wants meshes (the session's loop acts on it).
+        if (!mesher_ && surface->on)
+          refuse("this run has no fluid surface (not a fluid's run, or its frames have no masses)");
       }
     }
     if (changed) refresh_hello();
@@ -367,9 +430,10 @@ class ReplaySession {
 
   std::string status() const {
     return fmt::format(
-        R"({{"type":"status","mode":"replay","frame":{},"frames":{},"step":{},"time":{},"particles":{},"paused":{},"at_end":{},"speed":{}}})",
+        R"({{"type":"status","mode":"replay","frame":{},"frames":{},"step":{},"time":{},"particles":{},"paused":{},"at_end":{},"speed":{},"surface":{}}})",
         index_, run_.frames.size(), index_, json::number(run_.frames[index_].time), current_.x.size(),
-        json::boolean(!playing_), json::boolean(index_ + 1 == run_.frames.size()), json::number(speed_));
+        json::boolean(!playing_), json::boolean(index_ + 1 == run_.frames.size()), json::number(speed_),
+        mesher_json(mesher_.get()));
   }
 
   void refresh_hello() {
@@ -389,11 +453,12 @@ class ReplaySession {
     // Without a scene: a fluid has pressure, a gravity run a potential.
     auto has = [&](std::string_view name) { return std::find(fields_.begin(), fields_.end(), name) != fields_.end(); };
     const bool gravity = s ? s->nbody.has_value() : has("potential");
-    const bool sph = s ? s->sph.has_value() : has("pressure");
+    const bool sph = is_fluid();
     std::string text = fmt::format(
-        R"({{"type":"hello","mode":"replay","scene":{},"particles":{},"fields":[{}],"colour":{},"box":{},"gravity":{},"sph":{},"paused":{},"frames":{},"times":[{}],"parameters":[]}})",
+        R"({{"type":"hello","mode":"replay","scene":{},"particles":{},"fields":[{}],"colour":{},"box":{},"gravity":{},"sph":{},"paused":{},"frames":{},"times":[{}],"parameters":[],"surface":{},"surface_on":{}}})",
         json::string(run_.dir.string()), current_.x.size(), fields, colour_, box, json::boolean(gravity),
-        json::boolean(sph), json::boolean(!playing_), run_.frames.size(), times);
+        json::boolean(sph), json::boolean(!playing_), run_.frames.size(), times, json::boolean(mesher_ != nullptr),
+        json::boolean(mesher_ && options_.surface));
     std::lock_guard lock(hello_mutex_);
     hello_ = std::move(text);
   }
@@ -414,8 +479,11 @@ class ReplaySession {
   std::deque<Control> controls_;
   std::mutex hello_mutex_;
   std::string hello_;
+  double rest_density_ = 0;  // the scene's ρ0; 0: each particle's density gives its volume
+  std::size_t surface_viewers_ = 0;  // as last seen by the session's loop
 
   LiveServer server_;
+  std::unique_ptr<Mesher> mesher_;  // a fluid's run only; after server_, so that it stops first
 };
 
 }  // namespace

@@ -110,11 +110,100 @@ DecodedFrame decode_frame(std::span<const std::uint8_t> m) {
   return f;
 }
 
+std::string encode_mesh(const render::SurfaceMesh& mesh, std::uint64_t step, double time) {
+  const std::size_t v = mesh.vertices.size(), t = mesh.triangle_count();
+  if (mesh.normals.size() != v || mesh.indices.size() != 3 * t)
+    throw std::invalid_argument("encode_mesh: the mesh's arrays differ in length");
+  if (v > 0xffffffffu || t > 0xffffffffu) throw std::invalid_argument("encode_mesh: more than 2^32 vertices or triangles");
+  std::array<float, 3> lo{}, hi{};
+  if (v > 0) lo = hi = {mesh.vertices[0].x, mesh.vertices[0].y, mesh.vertices[0].z};
+  for (const auto& p : mesh.vertices)
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (!std::isfinite(p[int(a)])) throw std::invalid_argument("encode_mesh: a vertex is not finite");
+      lo[a] = std::min(lo[a], p[int(a)]), hi[a] = std::max(hi[a], p[int(a)]);
+    }
+  const std::uint16_t index_bytes = v <= 65536 ? 2 : 4;
+  std::string out;
+  out.reserve(kMeshHeaderBytes + 3 * index_bytes * t + 9 * v);
+  put(out, kMeshMagic);
+  put(out, kMeshVersion);
+  put(out, index_bytes);
+  put(out, step);
+  put(out, time);
+  put(out, std::uint32_t(v));
+  put(out, std::uint32_t(t));
+  for (const float x : lo) put(out, x);
+  for (const float x : hi) put(out, x);
+  put(out, float(mesh.cell_size));
+  put(out, float(mesh.iso));
+  for (const std::uint32_t i : mesh.indices) {
+    if (i >= v) throw std::invalid_argument(fmt::format("encode_mesh: index {} of {} vertices", i, v));
+    if (index_bytes == 2) put(out, std::uint16_t(i));
+    else put(out, i);
+  }
+  std::array<float, 3> scale{};
+  for (std::size_t a = 0; a < 3; ++a) scale[a] = hi[a] > lo[a] ? 65535.0f / (hi[a] - lo[a]) : 0.0f;
+  for (const auto& p : mesh.vertices)
+    for (std::size_t a = 0; a < 3; ++a) put(out, std::uint16_t(quantise(p[int(a)], lo[a], scale[a], 65535)));
+  for (const auto& n : mesh.normals)
+    for (int a = 0; a < 3; ++a) {
+      const float q = std::round(std::clamp(n[a], -1.0f, 1.0f) * 127.0f);  // NaN: 0 (no direction)
+      out.push_back(static_cast<char>(std::isfinite(q) ? std::int8_t(q) : std::int8_t{0}));
+    }
+  return out;
+}
+
+DecodedMesh decode_mesh(std::span<const std::uint8_t> m) {
+  if (m.size() < kMeshHeaderBytes) throw std::invalid_argument(fmt::format("mesh: {} bytes, shorter than the header", m.size()));
+  if (get<std::uint32_t>(m, 0) != kMeshMagic) throw std::invalid_argument("mesh: not a swirl mesh (magic)");
+  if (const auto v = get<std::uint16_t>(m, 4); v != kMeshVersion)
+    throw std::invalid_argument(fmt::format("mesh: version {}, this reader knows {}", v, kMeshVersion));
+  DecodedMesh d;
+  d.index_bytes = get<std::uint16_t>(m, 6);
+  d.step = get<std::uint64_t>(m, 8);
+  d.time = get<double>(m, 16);
+  const std::uint64_t v = get<std::uint32_t>(m, 24), t = get<std::uint32_t>(m, 28);
+  for (std::size_t a = 0; a < 3; ++a) {
+    d.lo[a] = get<float>(m, 32 + 4 * a);
+    d.hi[a] = get<float>(m, 44 + 4 * a);
+    if (!std::isfinite(d.lo[a]) || !std::isfinite(d.hi[a]) || d.lo[a] > d.hi[a])
+      throw std::invalid_argument("mesh: its bounds are not finite, or lo > hi");
+  }
+  d.cell = get<float>(m, 56);
+  d.iso = get<float>(m, 60);
+  if (d.index_bytes != 2 && d.index_bytes != 4)
+    throw std::invalid_argument(fmt::format("mesh: {}-byte indices (2 or 4)", d.index_bytes));
+  if (d.index_bytes == 2 && v > 65536)
+    throw std::invalid_argument(fmt::format("mesh: 2-byte indices for {} vertices", v));
+  const std::uint64_t expected = kMeshHeaderBytes + 3 * d.index_bytes * t + 9 * v;
+  if (m.size() != expected)
+    throw std::invalid_argument(
+        fmt::format("mesh: {} bytes for {} vertices and {} triangles, expected {}", m.size(), v, t, expected));
+  d.indices.resize(3 * t);
+  for (std::size_t k = 0; k < 3 * t; ++k) {
+    const std::size_t at = kMeshHeaderBytes + d.index_bytes * k;
+    const std::uint32_t i = d.index_bytes == 2 ? get<std::uint16_t>(m, at) : get<std::uint32_t>(m, at);
+    if (i >= v) throw std::invalid_argument(fmt::format("mesh: triangle {} names vertex {} of {}", k / 3, i, v));
+    d.indices[k] = i;
+  }
+  const std::size_t positions = kMeshHeaderBytes + 3 * d.index_bytes * t, normals = positions + 6 * v;
+  d.vertices.resize(v);
+  d.normals.resize(v);
+  for (std::size_t i = 0; i < v; ++i)
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto q = get<std::uint16_t>(m, positions + 6 * i + 2 * a);
+      d.vertices[i][int(a)] = d.lo[a] + float(q) / 65535.0f * (d.hi[a] - d.lo[a]);
+      d.normals[i][int(a)] = float(static_cast<std::int8_t>(m[normals + 3 * i + a])) / 127.0f;
+    }
+  return d;
+}
+
 namespace {
 enum Kind : std::uint8_t {
-  kPause = 1, kResume = 2, kStep = 3, kReset = 4, kSpeed = 5, kColour = 6, kPush = 7, kSeek = 8, kParameter = 9
+  kPause = 1, kResume = 2, kStep = 3, kReset = 4, kSpeed = 5, kColour = 6, kPush = 7, kSeek = 8, kParameter = 9,
+  kSurface = 10
 };
-constexpr std::size_t kPayload[] = {0, 0, 0, 0, 0, 4, 1, 33, 4, 13};  // bytes after the kind, by kind
+constexpr std::size_t kPayload[] = {0, 0, 0, 0, 0, 4, 1, 33, 4, 13, 1};  // bytes after the kind, by kind
 
 Parsed refuse(std::string why) { return Parsed{std::nullopt, std::move(why)}; }
 }  // namespace
@@ -122,7 +211,7 @@ Parsed refuse(std::string why) { return Parsed{std::nullopt, std::move(why)}; }
 Parsed parse_control(std::span<const std::uint8_t> m) {
   if (m.empty()) return refuse("an empty message");
   const std::uint8_t kind = m[0];
-  if (kind < kPause || kind > kParameter) return refuse(fmt::format("unknown control kind {}", kind));
+  if (kind < kPause || kind > kSurface) return refuse(fmt::format("unknown control kind {}", kind));
   if (m.size() != 1 + kPayload[kind])
     return refuse(fmt::format("control kind {} has {} bytes, expected {}", kind, m.size(), 1 + kPayload[kind]));
   auto f32 = [&](std::size_t k) { return get<float>(m, 1 + 4 * k); };
@@ -138,6 +227,9 @@ Parsed parse_control(std::span<const std::uint8_t> m) {
     }
     case kColour: return {control::Colour{m[1]}, {}};
     case kSeek: return {control::Seek{get<std::uint32_t>(m, 1)}, {}};
+    case kSurface:
+      if (m[1] > 1) return refuse("surface: 'on' must be 0 or 1");
+      return {control::Surface{m[1] == 1}, {}};
     case kParameter: {
       if (m[1] >= control::kParameterCount) return refuse(fmt::format("parameter: unknown parameter {}", m[1]));
       const auto v = [&](std::size_t k) { return get<float>(m, 2 + 4 * k); };
@@ -182,6 +274,9 @@ std::string encode_control(const Control& c) {
         } else if constexpr (std::is_same_v<T, control::Seek>) {
           out.push_back(char(kSeek));
           put(out, v.frame);
+        } else if constexpr (std::is_same_v<T, control::Surface>) {
+          out.push_back(char(kSurface));
+          out.push_back(char(v.on ? 1 : 0));
         } else if constexpr (std::is_same_v<T, control::Parameter>) {
           out.push_back(char(kParameter));
           out.push_back(char(v.id));

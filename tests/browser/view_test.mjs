@@ -8,7 +8,10 @@
 //   1. the page loads without a script error, WebGL2 is there, frames arrive;
 //   2. a screenshot of the canvas (panels hidden) has particles drawn: enough
 //      pixels unlike the background, in several shades (lit spheres);
-//   3. pause stops the step counter, play moves it again;
+//   3. pause stops the step counter, play moves it again; while paused, the
+//      "surface" box (shown: an SPH scene) brings surface meshes that pass the
+//      page's checks, and the picture changes from the particles to the water
+//      surface; unticked, the particles' picture comes back;
 //   4. with "push" ticked, a mouse drag across the fluid moves it: paused, the
 //      mouse pressed, dragged along +y (the screen's x axis) and held while the
 //      page's step button takes 300 steps, the pool's mean y in the frames
@@ -28,7 +31,8 @@
 //      slider is shown, the push and the step hidden; a click on the slider shows the
 //      frame under the pointer (the frames' positions change with it), the
 //      next/previous buttons step one frame, play reaches the last frame, and
-//      a screenshot has particles drawn.
+//      a screenshot has particles drawn; the surface box brings the last
+//      frame's mesh.
 // The page's test hook is window.swirlView (web/viewer.js).
 import { spawn, spawnSync } from "node:child_process";
 import fs from "node:fs";
@@ -122,24 +126,33 @@ async function main() {
   check(hello && hello.particles === 3840, `hello: ${hello && hello.particles} particles`);
 
   // 2. Screenshot of the canvas with the panels hidden.
-  await view(() => { for (const id of ["panel", "bar", "barlo", "barhi", "plot", "message"]) document.getElementById(id).style.visibility = "hidden"; });
-  await sleep(200);
-  const png = await page.screenshot({ type: "png", clip: { x: 0, y: 0, width: 800, height: 600 } });
-  if (outDir) { fs.mkdirSync(outDir, { recursive: true }); fs.writeFileSync(path.join(outDir, "view.png"), png); }
-  const pixels = await view(async (b64) => {  // decode the PNG in the page and count
-    const img = new Image(); img.src = "data:image/png;base64," + b64; await img.decode();
-    const c = new OffscreenCanvas(img.width, img.height), g = c.getContext("2d"); g.drawImage(img, 0, 0);
-    const d = g.getImageData(0, 0, img.width, img.height).data;
-    const bg = [d[0], d[1], d[2]];  // a corner: the clear colour (0.06, 0.08, 0.1)
-    let drawn = 0; const shades = new Set();
-    for (let i = 0; i < d.length; i += 4) {
-      if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 24) {
-        drawn++; shades.add((d[i] >> 3) << 10 | (d[i + 1] >> 3) << 5 | d[i + 2] >> 3);
+  // A screenshot of the canvas alone (panels hidden), decoded in the page:
+  // pixels unlike the background, their shades, and (given an earlier one)
+  // how many pixels differ from it.
+  const shoot = async (name, before = null) => {
+    await view(() => { for (const id of ["panel", "bar", "barlo", "barhi", "plot", "message"]) document.getElementById(id).style.visibility = "hidden"; });
+    await sleep(200);
+    const png = await page.screenshot({ type: "png", clip: { x: 0, y: 0, width: 800, height: 600 } });
+    await view(() => { for (const id of ["panel", "bar", "barlo", "barhi", "plot", "message"]) document.getElementById(id).style.visibility = ""; });
+    if (outDir) { fs.mkdirSync(outDir, { recursive: true }); fs.writeFileSync(path.join(outDir, name), png); }
+    const counts = await view(async (b64, b64before) => {
+      const decode = async (b) => { const img = new Image(); img.src = "data:image/png;base64," + b; await img.decode();
+        const c = new OffscreenCanvas(img.width, img.height), g = c.getContext("2d"); g.drawImage(img, 0, 0);
+        return g.getImageData(0, 0, img.width, img.height).data; };
+      const d = await decode(b64), e = b64before ? await decode(b64before) : null;
+      const bg = [d[0], d[1], d[2]];  // a corner: the clear colour (0.06, 0.08, 0.1)
+      let drawn = 0, changed = 0; const shades = new Set();
+      for (let i = 0; i < d.length; i += 4) {
+        if (Math.abs(d[i] - bg[0]) + Math.abs(d[i + 1] - bg[1]) + Math.abs(d[i + 2] - bg[2]) > 24) {
+          drawn++; shades.add((d[i] >> 3) << 10 | (d[i + 1] >> 3) << 5 | d[i + 2] >> 3);
+        }
+        if (e && Math.abs(d[i] - e[i]) + Math.abs(d[i + 1] - e[i + 1]) + Math.abs(d[i + 2] - e[i + 2]) > 24) changed++;
       }
-    }
-    return { drawn, total: d.length / 4, shades: shades.size, bg };
-  }, Buffer.from(png).toString("base64"));
-  await view(() => { for (const id of ["panel", "bar", "barlo", "barhi", "plot", "message"]) document.getElementById(id).style.visibility = ""; });
+      return { drawn, changed, total: d.length / 4, shades: shades.size, bg };
+    }, Buffer.from(png).toString("base64"), before ? Buffer.from(before).toString("base64") : null);
+    return { png, ...counts };
+  };
+  const pixels = await shoot("view.png");
   const frac = pixels.drawn / pixels.total;
   check(pixels.bg.join() === "15,20,26", `background ${pixels.bg} is the clear colour`);
   check(frac > 0.01 && frac < 0.6 && pixels.shades >= 20,
@@ -153,6 +166,28 @@ async function main() {
   const s2 = await view(() => window.swirlView.status.step);
   const f2 = await view(() => window.swirlView.step);
   check(s2 === s1 && f2 <= s2, `paused: the step stays at ${s1} -> ${s2} for 1 s (frame step ${f2})`);
+
+  // The surface, paused (so that only the surface changes the picture): the
+  // box ticked brings the mesh of the state shown, drawn instead of the particles.
+  // The frame of the paused state first (the colour sent again: a recolour sends it).
+  await view(() => sendColour(Number(document.getElementById("colour").value)));
+  await waitFor((t) => window.swirlView.step === t, "the paused state's frame", 10_000, s2);
+  const particlesShot = await shoot("view-particles.png");
+  const box = await view(() => getComputedStyle(document.getElementById("surfacelabel")).display);
+  check(box !== "none", `the surface box is shown for an SPH scene (display ${box})`);
+  await page.click("#surface");
+  await waitFor((t) => window.swirlView.mesh && window.swirlView.mesh.step === t, "the surface of the state shown", 15_000, s2);
+  const mesh = await view(() => ({ ...window.swirlView.mesh, rejected: window.swirlView.meshesRejected, why: window.swirlView.meshError }));
+  check(mesh.triangles > 1000 && mesh.rejected === 0,
+    `a surface mesh of step ${mesh.step}: ${mesh.vertices} vertices, ${mesh.triangles} triangles, ${mesh.rejected} rejected ${mesh.why}`);
+  const surfaceShot = await shoot("view-surface.png", particlesShot.png);
+  check(surfaceShot.drawn / surfaceShot.total > 0.01 && surfaceShot.changed > 0.02 * particlesShot.drawn,
+    `the surface drawn: ${(100 * surfaceShot.drawn / surfaceShot.total).toFixed(1)} % of the pixels, ` +
+    `${(100 * surfaceShot.changed / surfaceShot.total).toFixed(1)} % changed from the particles' picture`);
+  await page.click("#surface");
+  const backShot = await shoot("view-particles-again.png", particlesShot.png);
+  check(backShot.changed < 0.001 * backShot.total,
+    `unticked: the particles' picture again (${backShot.changed} pixels differ)`);
   await page.click("#play");
   await waitFor((s) => !window.swirlView.paused && window.swirlView.status.step > s + 20, "resumed", 15_000, s2);
   const s3 = await view(() => window.swirlView.status.step);
@@ -328,6 +363,10 @@ async function replay() {
     await waitFor(() => window.swirlView.step === 10 && window.swirlView.status.at_end, "the last frame", 15_000);
     const end = await view(() => ({ slider: document.getElementById("slider").value, paused: window.swirlView.paused }));
     check(end.slider === "10" && end.paused, `play reaches the last frame and stops there (${JSON.stringify(end)})`);
+    await page.click("#surface");  // the last frame's surface
+    await waitFor(() => window.swirlView.mesh && window.swirlView.mesh.step === 10, "the last frame's surface", 15_000);
+    const rm = await view(() => ({ ...window.swirlView.mesh, rejected: window.swirlView.meshesRejected }));
+    check(rm.triangles > 1000 && rm.rejected === 0, `replay: the surface of frame ${rm.step}, ${rm.triangles} triangles`);
     const png = await page.screenshot({ type: "png", clip: { x: 0, y: 0, width: 800, height: 600 } });
     if (outDir) fs.writeFileSync(path.join(outDir, "replay.png"), png);
     const drawn = await view(async (b64) => {
@@ -337,7 +376,7 @@ async function replay() {
       for (let i = 0; i < d.length; i += 4) if (Math.abs(d[i] - 15) + Math.abs(d[i + 1] - 20) + Math.abs(d[i + 2] - 26) > 24) n++;
       return n / (d.length / 4);
     }, Buffer.from(png).toString("base64"));
-    check(drawn > 0.01, `replay screenshot: ${(100 * drawn).toFixed(1)} % of pixels drawn`);
+    check(drawn > 0.01, `replay screenshot (the surface): ${(100 * drawn).toFixed(1)} % of pixels drawn`);
     check(errors.length === 0, `no script errors on the replay page${errors.length ? ": " + errors.join("; ") : ""}`);
   } finally {
     if (browser) await browser.close().catch(() => {});

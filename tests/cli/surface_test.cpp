@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cli/cli_support.hpp"
+#include "swirl/render/obj.hpp"
 #include "swirl/render/png.hpp"
 #include "swirl/render/ply.hpp"
 
@@ -71,6 +72,46 @@ TEST_F(Surface, NeverOverwritesAFileTheRunDidNotMake) {
   const auto r = swirl("run " + write_scene("s.toml", fluid_scene("surface = \"ply\"")).string() + " --out " + run.string());
   EXPECT_NE(r.status, 0);
   EXPECT_EQ(slurp(run / "surface_000000.ply"), "mine");
+}
+
+// output.surface = "obj": the same meshes as "ply", as OBJ text, and no series
+// (ParaView's OBJ reader takes one file).
+TEST_F(Surface, ObjHoldsTheMeshesThePlyDoes) {
+  const auto ply = dir_ / "ply", obj = dir_ / "obj";
+  ASSERT_EQ(swirl("run " + write_scene("p.toml", fluid_scene("surface = \"ply\"")).string() + " --out " + ply.string())
+                .status, 0);
+  const auto r = swirl("run " + write_scene("o.toml", fluid_scene("surface = \"obj\"")).string() + " --out " +
+                       obj.string() + " --threads 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  for (const char* frame : {"000000", "000001", "000002"}) {
+    const std::string name = std::string("surface_") + frame;
+    ASSERT_TRUE(fs::exists(obj / (name + ".obj"))) << name;
+    EXPECT_FALSE(fs::exists(obj / (name + ".ply"))) << name;
+    const auto a = swirl::render::read_ply(ply / (name + ".ply"));
+    const auto b = swirl::render::read_obj(obj / (name + ".obj"));
+    EXPECT_EQ(b.mesh.vertices.size(), a.mesh.vertices.size()) << name;
+    EXPECT_EQ(b.mesh.triangle_count(), a.mesh.triangle_count()) << name;
+    EXPECT_GT(b.mesh.triangle_count(), 100u) << name;
+    EXPECT_EQ(swirl::render::enclosed_volume(b.mesh), swirl::render::enclosed_volume(a.mesh)) << name;
+    EXPECT_EQ(b.time, a.time) << name;
+  }
+  EXPECT_FALSE(fs::exists(obj / "surface.ply.series"));
+  EXPECT_FALSE(fs::exists(obj / "surface.obj.series"));
+  // Claimed in the run's manifest: --overwrite deletes and remakes them.
+  EXPECT_NE(slurp(obj / "manifest.txt").find("surface_000002.obj"), std::string::npos);
+  const auto again = swirl("run " + (dir_ / "o.toml").string() + " --out " + obj.string() + " --overwrite");
+  ASSERT_EQ(again.status, 0) << again.err;
+  EXPECT_TRUE(fs::exists(obj / "surface_000002.obj"));
+}
+
+TEST_F(Surface, AnUnknownFormatIsRefusedNamingTheKeyAndTheChoices) {
+  const auto r = swirl("run " + write_scene("x.toml", fluid_scene("surface = \"stl\"")).string() + " --out " +
+                       (dir_ / "x").string());
+  EXPECT_EQ(r.status, 2) << r.out << r.err;
+  EXPECT_NE(r.err.find("output.surface"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("stl"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("obj"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x" / "particles_000000.vtp"));
 }
 
 TEST_F(Surface, RenderDrawsWater) {

@@ -9,13 +9,14 @@ must be placed in it.
 
 The ranks are the layering that holds today (lowest first). docs name the
 coarse layers core; parallel; spatial, io; dist; force, integrate, boundary, sph,
-gravity; scene; sim; render, view; CLI. dist sits above spatial: the ghosts
+gravity; scene; sim; render; view; CLI. dist sits above spatial: the ghosts
 of a rank (dist/halo.hpp) are found in the particle order's key frame and cells. Within the solver layer the includes are
 finer: the steppers (integrate) apply the box (boundary) and return the
 step's scan (force/step_scan.hpp); sph and gravity implement the Solver seam
 (force) and gravity's benchmark steps with a stepper (integrate). So
 boundary < force < integrate < sph, gravity. render reads scenes (the run's
-Scene) and io (frames) but not sim.
+Scene) and io (frames) but not sim; view sits above render, whose surface
+mesh it sends the page.
 
 Usage: check_layering.py SOURCE_DIR
 """
@@ -34,8 +35,9 @@ RANK = {
     "sph": 7, "gravity": 7,
     "scene": 8,
     "sim": 9,
-    "render": 10, "view": 10,
-    "apps": 11,  # apps/swirl: the CLI, above everything
+    "render": 10,
+    "view": 11,  # the live view sends the fluid's surface (render/surface_mesh.hpp)
+    "apps": 12,  # apps/swirl: the CLI, above everything
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]swirl/([A-Za-z0-9_]+)/', re.MULTILINE)

@@ -225,4 +225,47 @@ TEST(ThreadPool, NestedAndConcurrentLoopsRunSeriallyOnTheirCaller) {
   for (double r : results) EXPECT_EQ(r, reference);
 }
 
+// Under a SerialScope a thread's loops run on it alone (the pool stays free
+// for another thread's jobs), with the same results; the scope ends with it.
+TEST(ThreadPool, ASerialScopeKeepsItsThreadsLoopsOffThePool) {
+  swirl::parallel::set_thread_count(3);
+  std::vector<double> values(100000);
+  for (std::size_t i = 0; i < values.size(); ++i) values[i] = 1.0 / double(i + 1);
+  const auto sum = [&] {
+    return reduce_blocks(
+        "sum", values.size(), 97, 0.0,
+        [&](std::size_t b, std::size_t e) {
+          double s = 0;
+          for (std::size_t i = b; i < e; ++i) s += values[i];
+          std::this_thread::sleep_for(std::chrono::microseconds(20));
+          return s;
+        },
+        [](double x, double y) { return x + y; });
+  };
+  const double pooled = sum();
+  std::atomic<int> highest{0};
+  double serial = 0;
+  {
+    swirl::parallel::SerialScope scope;
+    {
+      swirl::parallel::SerialScope nested;
+    }
+    EXPECT_TRUE(swirl::parallel::detail::ThreadPool::serial_here()) << "a nested scope restores the outer one";
+    serial = sum();
+    for_blocks("serial", 64, 1, [&](std::size_t, std::size_t, std::size_t) {
+      highest = std::max(highest.load(), swirl::parallel::thread_index());
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    });
+  }
+  EXPECT_EQ(highest.load(), 0) << "a worker ran a block of a serial scope's loop";
+  EXPECT_EQ(serial, pooled);
+  EXPECT_FALSE(swirl::parallel::detail::ThreadPool::serial_here());
+  for (int attempt = 0; attempt < 100 && highest.load() == 0; ++attempt)
+    for_blocks("pooled again", 16, 1, [&](std::size_t, std::size_t, std::size_t) {
+      highest = std::max(highest.load(), swirl::parallel::thread_index());
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    });
+  EXPECT_GT(highest.load(), 0) << "after the scope the pool takes part again";
+}
+
 }  // namespace

@@ -1,8 +1,9 @@
 // A live session (view/live_run.hpp) driven by WebSocket clients of our own
 // (Boost.Beast): the hello and the frames a page receives, pause / step /
-// resume, the mouse's push moving the fluid, and hostile messages — unknown
-// kinds, bad values, an oversized message — dropped without stopping the run
-// or the other viewers.
+// resume, the mouse's push moving the fluid, the surface meshes (the fluid's
+// volume, only to the viewers who ask, only while someone does), and hostile
+// messages — unknown kinds, bad values, an oversized message — dropped
+// without stopping the run or the other viewers.
 #include <gtest/gtest.h>
 #include <sys/socket.h>
 #include <sys/time.h>
@@ -10,6 +11,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <future>
 #include <mutex>
 #include <vector>
@@ -21,7 +23,9 @@
 #include <boost/beast.hpp>
 #include <boost/beast/websocket.hpp>
 
+#include "swirl/render/surface_mesh.hpp"
 #include "swirl/scene/load.hpp"
+#include "swirl/sim/build.hpp"
 #include "swirl/view/live_run.hpp"
 #include "swirl/view/push_force.hpp"
 #include "view/ws_client.hpp"
@@ -39,7 +43,7 @@ std::uint64_t field_u64(const std::string& json, const std::string& key) {
 
 class LiveSession : public ::testing::Test {
  protected:
-  void start(bool paused = false) {
+  void start(bool paused = false, bool surface = false) {
     const std::string file = std::string(SWIRL_SOURCE_DIR) + "/examples/dam_break.toml";
     // The column fills the box's y exactly (16 layers of 0.03): symmetric across y = 0.24.
     const std::vector<std::string> overrides{"particles.0.spacing=0.03", "simulation.end_time=100",
@@ -49,6 +53,7 @@ class LiveSession : public ::testing::Test {
     options_.fps = 60;
     options_.threads = 1;
     options_.start_paused = paused;
+    options_.surface = surface;
     options_.stop = &stop_;
     options_.log = [this](const std::string& line) {
       std::lock_guard lock(log_mutex_);
@@ -146,6 +151,100 @@ float mean_y(const DecodedFrame& f) {
   double sum = 0;
   for (const float y : f.y) sum += y;
   return float(sum / double(f.y.size()));
+}
+
+// The volume a decoded mesh's triangles enclose.
+double volume_of(const DecodedMesh& m) {
+  render::SurfaceMesh mesh;
+  mesh.vertices = m.vertices;
+  mesh.indices = m.indices;
+  return render::enclosed_volume(mesh);
+}
+
+// The fluid's volume Σ m/ρ0 of a scene's initial particles (its lattice mass
+// makes an interior particle's SPH density ρ0).
+double fluid_volume(const scene::Scene& scene) {
+  const auto sim = sim::build_simulation<float>(scene);
+  double v = 0;
+  for (std::size_t i = 0; i < sim.particles().size(); ++i) v += double(sim.particles().mass[i]);
+  return v / scene.sph->rest_density;
+}
+
+// The dam break's column (0.3 × 0.48 × 0.4 m of water, particles 0.03 m
+// apart against the box's walls): the surface a viewer turns on encloses the
+// fluid's volume Σ m/ρ0 within a few per cent at the start, and still after
+// the column has fallen for 150 steps.
+TEST_F(LiveSession, SurfaceMeshesEncloseTheFluidsVolume) {
+  start(/*paused=*/true);
+  const double fluid = fluid_volume(scene_);
+  Viewer v(port_);
+  auto [text, hello] = v.next();
+  EXPECT_NE(hello.find(R"("surface":true,"surface_on":false)"), std::string::npos) << hello;
+  v.send(encode_control(control::Surface{true}));
+  const DecodedMesh a = v.mesh();
+  EXPECT_EQ(a.step, 0u) << "paused: the surface of the state shown";
+  EXPECT_GT(a.triangle_count(), 1000u);
+  EXPECT_EQ(a.iso, 0.5f);
+  EXPECT_NEAR(a.cell, 0.03f, 0.001f) << "the view's cell: one particle spacing";
+  const double va = volume_of(a);
+  std::printf("surface at step 0: %zu vertices, %zu triangles, %.6f m³ (fluid %.6f m³, ratio %.4f)\n",
+              a.vertices.size(), a.triangle_count(), va, fluid, va / fluid);
+  EXPECT_NEAR(va / fluid, 1.0, 0.04);
+  // 150 single steps: each one's state is offered to the mesher (a state
+  // waiting for it is replaced), so the last mesh is step 150's, whatever the
+  // machine's speed; one thread: the same run every time.
+  for (int k = 0; k < 150; ++k) v.send(encode_control(control::Step{}));
+  DecodedMesh b = v.mesh();
+  for (int k = 0; k < 400 && b.step < 150; ++k) b = v.mesh();
+  ASSERT_EQ(b.step, 150u);
+  const double vb = volume_of(b);
+  std::printf("surface at step %llu: %zu triangles, %.6f m³ (ratio %.4f)\n", static_cast<unsigned long long>(b.step),
+              b.triangle_count(), vb, vb / fluid);
+  EXPECT_NEAR(vb / fluid, 1.0, 0.05);
+  EXPECT_GT(std::abs(b.lo[0] - a.lo[0]) + std::abs(b.hi[0] - a.hi[0]) + std::abs(b.hi[2] - a.hi[2]), 0.01)
+      << "the surface follows the falling column";
+  const ViewResult r = finish();
+  EXPECT_GE(r.mesher.meshes, 2u);
+  EXPECT_GE(r.server.meshes_sent, 2u);
+}
+
+// Meshes go only to the viewers that turned the surface on, and are made
+// only while one has: none before, none after the last one turns it off.
+TEST_F(LiveSession, MeshesAreMadeForAndSentToTheViewersWhoAskOnly) {
+  start();
+  Viewer asks(port_), not_asking(port_);
+  const auto meshes_made = [&](Viewer& v) {  // from a status: the server's count of meshes made
+    const std::string st = test::next_text(v, "status");
+    const auto at = st.find(R"("surface":{"meshes":)");
+    return at == std::string::npos ? ~std::uint64_t{0} : std::stoull(st.substr(at + 20));
+  };
+  for (int k = 0; k < 10; ++k) not_asking.frame();
+  EXPECT_EQ(meshes_made(not_asking), 0u) << "nobody asked: no mesh made";
+  asks.send(encode_control(control::Surface{true}));
+  const DecodedMesh first = asks.mesh();
+  EXPECT_GT(first.triangle_count(), 100u);
+  for (int k = 0; k < 3; ++k) EXPECT_GT(asks.mesh().step, first.step - 1);
+  for (int k = 0; k < 30; ++k) {  // the other viewer's binary messages are all frames
+    auto [text, data] = not_asking.next();
+    EXPECT_FALSE(!text && Viewer::is_mesh(data)) << "a mesh sent to a viewer that did not ask";
+  }
+  asks.send(encode_control(control::Surface{false}));
+  std::this_thread::sleep_for(300ms);  // a mesh in the making when it was turned off may still finish
+  const std::uint64_t after_off = meshes_made(not_asking);
+  std::this_thread::sleep_for(1s);
+  std::uint64_t later = meshes_made(not_asking);
+  for (int k = 0; k < 3; ++k) later = meshes_made(not_asking);  // the newest status
+  EXPECT_GT(after_off, 0u);
+  EXPECT_EQ(later, after_off) << "no viewer wants the surface: no mesh made";
+}
+
+// --surface: a viewer starts with the surface on, without asking.
+TEST_F(LiveSession, WithSurfaceOnAViewerGetsMeshesWithoutAsking) {
+  start(/*paused=*/true, /*surface=*/true);
+  Viewer v(port_);
+  auto [text, hello] = v.next();
+  EXPECT_NE(hello.find(R"("surface":true,"surface_on":true)"), std::string::npos) << hello;
+  EXPECT_GT(v.mesh().triangle_count(), 100u);
 }
 
 TEST_F(LiveSession, TheMousePushMovesTheFluid) {
@@ -273,6 +372,42 @@ TEST(LiveSessionGravity, TheSofteningSliderReachesTheTreeWalk) {
   const ViewResult r = run.get();
   EXPECT_EQ(r.parameter_changes, 1u);
   EXPECT_EQ(r.refused, 1u);
+}
+
+// A gravity run has no surface: the hello says so, the control is refused
+// with its reason, and --surface stops at once.
+TEST(LiveSessionGravity, HasNoSurface) {
+  const scene::Scene scene = scene::load_scene(std::string(SWIRL_SOURCE_DIR) + "/examples/plummer.toml",
+                                               std::vector<std::string>{"particles.0.count=200"});
+  std::atomic<bool> stop{false};
+  ViewOptions options;
+  options.threads = 1;
+  options.start_paused = true;
+  options.stop = &stop;
+  std::promise<std::uint16_t> listening;
+  auto port = listening.get_future();
+  options.on_listening = [&listening](const LiveServer& s) { listening.set_value(s.port()); };
+  auto run = std::async(std::launch::async, [&] { return view_scene(scene, options); });
+  {
+    Viewer v(port.get());
+    auto [text, hello] = v.next();
+    EXPECT_NE(hello.find(R"("surface":false)"), std::string::npos) << hello;
+    v.send(encode_control(control::Surface{true}));
+    EXPECT_NE(test::next_text(v, "refused").find("no [sph]"), std::string::npos);
+  }
+  stop = true;
+  const ViewResult r = run.get();
+  EXPECT_EQ(r.refused, 1u);
+  EXPECT_EQ(r.mesher.meshes, 0u);
+  options.surface = true;
+  options.on_listening = nullptr;
+  try {
+    view_scene(scene, options);
+    ADD_FAILURE() << "--surface on a gravity scene was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--surface"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("[sph]"), std::string::npos) << e.what();
+  }
 }
 
 TEST(PushForce, RelaxesVelocitiesTowardTheDragWithinItsRadiusOnly) {

@@ -1,7 +1,9 @@
 // `swirl view RUN_DIR` (view/replay.hpp): a run folder's frames listed and
 // served to a WebSocket viewer in order, the slider's seek answered with that
 // frame's positions, from .vtp frames and from HDF5 snapshots; a folder that
-// is not a run's and a frame that does not read are errors naming the file.
+// is not a run's and a frame that does not read are errors naming the file;
+// a fluid's run shows its surface, made from the frame shown, without the
+// boundary particles.
 //
 // The run folder is written here with swirl's writers (io::write_vtp, the
 // .pvd series, io::write_snapshot): six frames of 40 particles whose
@@ -23,6 +25,7 @@
 #include "swirl/io/pvd.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/io/vtp.hpp"
+#include "swirl/render/fluid_surface.hpp"
 #include "swirl/view/replay.hpp"
 #include "view/ws_client.hpp"
 
@@ -239,6 +242,112 @@ TEST_F(Replay, AFrameThatDoesNotReadIsAnErrorNamingItsFile) {
     FAIL() << "an unreadable first frame";
   } catch (const io::IoError& e) {
     EXPECT_NE(std::string(e.what()).find("particles_000000.vtp"), std::string::npos) << e.what();
+  }
+}
+
+// A run of two frames of a block of water (6 × 6 × 6 particles 1 cm apart,
+// moved 5 cm along x in the second) over a floor of boundary particles
+// (kind 1), without a scene.toml: the volumes are m/ρ of each particle. With
+// --surface a viewer gets the surface of the frame shown, the block's alone
+// (the mesh render::frame_surface makes of the file), and the next frame's
+// after a seek.
+TEST(ReplaySurface, AFluidRunShowsTheSurfaceOfTheFrameShown) {
+  const fs::path dir = fs::temp_directory_path() /
+                       ("swirl_replay_surface_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  constexpr double s = 0.01;
+  io::PvdSeries series(dir / "particles.pvd");
+  for (int k = 0; k < 2; ++k) {
+    ParticleSet<double> p(216 + 100);
+    const std::size_t kind = p.add_int_field("kind");
+    std::size_t i = 0;
+    for (int c = 0; c < 216; ++c, ++i) {
+      p.position.set(i, Vec3d{0.1 + 0.05 * k + s * (c % 6), 0.1 + s * (c / 6 % 6), 0.02 + s * (c / 36)});
+      p.mass[i] = 1000 * s * s * s;
+      p.density[i] = 1000;
+    }
+    for (int c = 0; c < 100; ++c, ++i) {  // the floor: 10 × 10 boundary particles
+      p.position.set(i, Vec3d{0.08 + s * (c % 10), 0.08 + s * (c / 10), 0.0});
+      p.mass[i] = 0.4 * 1000 * s * s * s;  // a volume weight, not water
+      p.density[i] = 1000;
+      p.int_field(kind)[i] = 1;
+    }
+    for (i = 0; i < p.size(); ++i) p.id[i] = i;
+    const std::string name = "particles_00000" + std::to_string(k) + ".vtp";
+    io::write_vtp(dir / name, p, 0.1 * k);
+    series.add(0.1 * k, name);
+  }
+  ViewOptions options;
+  options.server.port = 0;
+  options.fps = 60;
+  options.start_paused = true;
+  options.surface = true;
+  std::atomic<bool> stop{false};
+  options.stop = &stop;
+  std::promise<std::uint16_t> listening;
+  auto port = listening.get_future();
+  options.on_listening = [&listening](const LiveServer& server) { listening.set_value(server.port()); };
+  const RunFrames frames = open_run(dir);
+  auto run = std::async(std::launch::async, [&] { return replay_run(frames, options); });
+  {
+    Viewer v(port.get());
+    auto [text, hello] = v.next();
+    EXPECT_NE(hello.find(R"("surface":true,"surface_on":true)"), std::string::npos) << hello;
+    render::FluidSurface settings;  // the view's: m/ρ, cell 1 spacing
+    settings.cell = 1.0;
+    for (int k = 0; k < 2; ++k) {
+      if (k == 1) v.send(encode_control(control::Seek{1}));
+      DecodedMesh m = v.mesh();
+      for (int tries = 0; tries < 10 && m.step != std::uint64_t(k); ++tries) m = v.mesh();
+      ASSERT_EQ(m.step, std::uint64_t(k));
+      const render::SurfaceMesh expected =
+          render::frame_surface(render::load_frame(dir / ("particles_00000" + std::to_string(k) + ".vtp")), settings);
+      EXPECT_EQ(m.indices, expected.indices) << "frame " << k;
+      EXPECT_EQ(m.vertices.size(), expected.vertices.size()) << "frame " << k;
+      EXPECT_NEAR(m.lo[0], 0.1 + 0.05 * k - s, 0.5 * s) << "the block's surface, not the floor's (from 0.08)";
+      EXPECT_GT(m.lo[2], 0.005) << "the floor is not water";
+      render::SurfaceMesh back;
+      back.vertices = m.vertices;
+      back.indices = m.indices;
+      EXPECT_NEAR(render::enclosed_volume(back) / render::enclosed_volume(expected), 1.0, 1e-4);
+      EXPECT_NEAR(render::enclosed_volume(back) / (216 * s * s * s), 0.93, 0.04) << "a small cube's rounded edges";
+    }
+  }
+  stop = true;
+  const ViewResult r = run.get();
+  EXPECT_GE(r.mesher.meshes, 2u);
+  fs::remove_all(dir);
+}
+
+// Not a fluid's run (the fixture's frames lack nothing, but a gravity run's
+// scene says so): --surface is refused at once, naming the folder.
+TEST_F(Replay, SurfaceNeedsAFluidsRun) {
+  io::write_file_atomic(dir_ / "scene.toml", R"([simulation]
+dt = 0.01
+steps = 2
+
+[nbody]
+softening = 0.05
+
+[[particles]]
+kind = "plummer"
+count = 64
+seed = 1
+)");
+  const RunFrames frames = open_run(dir_);
+  ASSERT_TRUE(frames.scene) << frames.scene_note;
+  ViewOptions options;
+  options.server.port = 0;
+  options.surface = true;
+  const std::atomic<bool> stopped{true};
+  options.stop = &stopped;
+  try {
+    replay_run(frames, options);
+    FAIL() << "--surface on a gravity run";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("--surface"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("not a fluid's run"), std::string::npos) << e.what();
   }
 }
 

@@ -1,6 +1,6 @@
 // A WebSocket client of swirl view's server for the tests (Boost.Beast): a
-// viewer that reads the hello, statuses and frames with a deadline, so that a
-// test fails rather than hangs, and sends controls.
+// viewer that reads the hello, statuses, frames and surface meshes with a
+// deadline, so that a test fails rather than hangs, and sends controls.
 #pragma once
 
 #include <chrono>
@@ -48,12 +48,27 @@ class Viewer {
     if (result) throw beast::system_error(result);
     return {ws_.got_text(), beast::buffers_to_string(buffer.data())};
   }
-  // The next frame, skipping text messages.
+  // The next frame, skipping text messages and meshes; throws after 30 s.
   DecodedFrame frame() {
-    for (;;) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (std::chrono::steady_clock::now() < until) {
       auto [text, data] = next();
-      if (!text) return decode_frame({reinterpret_cast<const std::uint8_t*>(data.data()), data.size()});
+      if (!text && !is_mesh(data)) return decode_frame(bytes(data));
     }
+    throw std::runtime_error("no frame from the server within 30 s");
+  }
+  // The next surface mesh, skipping text messages and frames; throws after 30 s.
+  DecodedMesh mesh() {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+    while (std::chrono::steady_clock::now() < until) {
+      auto [text, data] = next();
+      if (!text && is_mesh(data)) return decode_mesh(bytes(data));
+    }
+    throw std::runtime_error("no surface mesh from the server within 30 s");
+  }
+  static bool is_mesh(const std::string& data) { return data.rfind("SWVM", 0) == 0; }
+  static std::span<const std::uint8_t> bytes(const std::string& data) {
+    return {reinterpret_cast<const std::uint8_t*>(data.data()), data.size()};
   }
   // The next status message's text.
   std::string status() {

@@ -93,6 +93,25 @@ inline std::string clamp_default_thread_count() {
          std::to_string(max) + ", the most swirl starts on this machine";
 }
 
+// While alive, the parallel loops of the thread that made it run on that
+// thread alone, never on the pool. For a thread working beside the
+// simulation (swirl view's mesher): its loops would otherwise take the pool
+// whenever the simulation's thread is between two passes, and a pass the
+// simulation submits meanwhile runs serially on its caller (one job at a
+// time), so the solver would lose its workers for the length of the other
+// thread's loop. The blocks, and so the results, are the same either way.
+// Scopes nest; each restores what it found.
+class SerialScope {
+ public:
+  SerialScope() : before_(detail::ThreadPool::serial_here()) { detail::ThreadPool::set_serial_here(true); }
+  ~SerialScope() { detail::ThreadPool::set_serial_here(before_); }
+  SerialScope(const SerialScope&) = delete;
+  SerialScope& operator=(const SerialScope&) = delete;
+
+ private:
+  bool before_;
+};
+
 // Number of blocks of block_size items covering n items.
 constexpr std::size_t block_count(std::size_t n, std::size_t block_size) {
   return block_size == 0 ? 0 : (n + block_size - 1) / block_size;

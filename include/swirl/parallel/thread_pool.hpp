@@ -22,7 +22,8 @@
 // caller closes the job and waits for the active count to drop to zero before it
 // returns, so no thread touches a finished job's task. A job submitted from
 // inside a job, or while another thread's job is running, runs serially on its
-// caller. thread_index() is 0 on the caller (and on any thread outside the
+// caller, and so does every job of a thread that asked for it
+// (set_serial_here: a thread beside the solver's). thread_index() is 0 on the caller (and on any thread outside the
 // pool) and 1..size()-1 on the workers.
 #pragma once
 
@@ -99,6 +100,11 @@ class ThreadPool {
 
   static int thread_index() noexcept { return index_; }
 
+  // While set, the jobs this thread submits run serially on it and leave the
+  // pool to the others (parallel::SerialScope).
+  static void set_serial_here(bool serial) noexcept { serial_here_ = serial; }
+  static bool serial_here() noexcept { return serial_here_; }
+
   // Runs task(context, b) once for every b in [0, blocks), the blocks split into
   // `runs` contiguous runs (1 ≤ runs ≤ size()), run r first offered to thread r.
   // task must not throw.
@@ -109,7 +115,7 @@ class ThreadPool {
     };
     // inside_ first: the caller of the running job holds submit_, and must not
     // try to lock it again.
-    if (inside_ || size() == 1 || blocks == 1) return serially();
+    if (inside_ || serial_here_ || size() == 1 || blocks == 1) return serially();
     std::unique_lock lock(submit_, std::try_to_lock);
     if (!lock.owns_lock()) return serially();
     task_ = task;
@@ -206,6 +212,7 @@ class ThreadPool {
 
   static inline thread_local int index_ = 0;
   static inline thread_local bool inside_ = false;
+  static inline thread_local bool serial_here_ = false;
 
   std::mutex submit_;  // one job at a time; also guards resize
   std::vector<std::thread> workers_;

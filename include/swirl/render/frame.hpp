@@ -3,6 +3,7 @@
 // HDF5 snapshot (.h5, io/snapshot.hpp).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <string_view>
 #include <vector>
@@ -23,6 +24,7 @@ struct Frame {
   std::vector<Vec3d> positions;
   std::vector<Vec3d> velocity;      // each field: empty when the file has no such array
   std::vector<double> mass, density, pressure;
+  std::vector<std::int32_t> kind;   // core/particle_kind.hpp (fluid 0, boundary 1); empty: all fluid
 };
 
 // Reads a .vtp or .h5 frame (by extension). Throws io::IoError naming the

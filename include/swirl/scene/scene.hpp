@@ -34,7 +34,7 @@ namespace swirl::scene {
 enum class Precision { Float, Double };
 enum class OutputFormat { Vtp, Csv, Hdf5 };
 // output.surface: the fluid's surface mesh per frame (render/surface_mesh.hpp), or none.
-enum class SurfaceFormat { None, Ply };
+enum class SurfaceFormat { None, Ply, Obj };
 // The unit system of a scene's numbers: SI (m, s, kg; G = 6.67430e-11
 // m³ kg⁻¹ s⁻²) or N-body units (G = 1, Hénon units for the stellar models).
 enum class Units { SI, NBody };
@@ -45,8 +45,8 @@ enum class TimeSteps { Global, Block };
 inline constexpr std::array<EnumName<Precision>, 2> kPrecisionNames{{{"float", Precision::Float}, {"double", Precision::Double}}};
 inline constexpr std::array<EnumName<OutputFormat>, 3> kOutputFormatNames{
     {{"vtp", OutputFormat::Vtp}, {"csv", OutputFormat::Csv}, {"hdf5", OutputFormat::Hdf5}}};
-inline constexpr std::array<EnumName<SurfaceFormat>, 2> kSurfaceFormatNames{
-    {{"none", SurfaceFormat::None}, {"ply", SurfaceFormat::Ply}}};
+inline constexpr std::array<EnumName<SurfaceFormat>, 3> kSurfaceFormatNames{
+    {{"none", SurfaceFormat::None}, {"ply", SurfaceFormat::Ply}, {"obj", SurfaceFormat::Obj}}};
 inline constexpr std::array<EnumName<Units>, 2> kUnitsNames{{{"si", Units::SI}, {"nbody", Units::NBody}}};
 inline constexpr std::array<EnumName<TimeSteps>, 2> kTimeStepsNames{
     {{"global", TimeSteps::Global}, {"block", TimeSteps::Block}}};

@@ -5,11 +5,15 @@
 // state into a frame (view/wire.hpp) off the simulation's path; the server
 // (view/live_server.hpp) sends it. The simulation copies positions and the
 // coloured field only when the encoder is idle and a frame is due (fps), so a
-// viewer costs it one copy per frame and never a wait.
+// viewer costs it one copy per frame and never a wait. A fourth, the mesher
+// (view/mesher.hpp; SPH scenes), makes the fluid's surface mesh from the same
+// copy (with each particle's volume, copied then too) while some viewer has
+// the surface on and the mesher is free.
 //
 // Controls from the page act between steps: pause, resume, one step, reset
 // (the scene built again from its start), a speed cap, the field that colours
-// the particles, the mouse's push: an external force (PushForce, a solver
+// the particles, the surface (on for a viewer: the surface of the state shown
+// now, also while paused), the mouse's push: an external force (PushForce, a solver
 // like any other) a = strength·(v_drag − v)·(1 − r/R) on the particles within
 // R of the point, which drags the fluid along with the pointer, and the live
 // parameters (view/parameters.hpp: viscosity, gravity, softening), each change
@@ -28,6 +32,7 @@
 
 #include "swirl/scene/scene.hpp"
 #include "swirl/view/live_server.hpp"
+#include "swirl/view/mesher.hpp"
 
 namespace swirl::view {
 
@@ -36,6 +41,12 @@ struct ViewOptions {
   int threads = 0;        // worker threads of the simulation (0: OpenMP's default)
   double fps = 30;        // frames per second sent at most
   bool start_paused = false;
+  bool surface = false;       // every viewer starts with the surface on (SPH scenes and runs only)
+  // The surface mesh's grid cell, in particle spacings: coarser than a run's
+  // output.surface_cell (½), so that a mesh is made in a frame or two
+  // (docs/performance/view.md); its kernel radius and level are the scene's
+  // output.surface_radius and output.surface_iso.
+  double surface_cell = 1.0;
   const std::atomic<bool>* stop = nullptr;  // set (by a signal, or a test) to end the session
   std::function<void(const std::string&)> log;
   // Called once the server listens (the CLI prints the URL; tests connect).
@@ -52,9 +63,15 @@ struct ViewResult {
   std::uint64_t frames_read = 0;  // replay: frame files read (steps: frames shown)
   double read_seconds = 0;        // replay: time spent reading them
   ServerStats server;
+  MesherStats mesher;             // the surface meshes made (none unless a viewer turned the surface on)
 };
 
-// Runs until *options.stop; throws std::runtime_error when the server cannot listen.
+// The server's options of a session: options.server, new viewers starting
+// with the surface on when options.surface.
+ServerOptions server_options(const ViewOptions& options);
+
+// Runs until *options.stop; throws std::runtime_error when the server cannot
+// listen, std::invalid_argument for options.surface on a scene without [sph].
 ViewResult view_scene(const scene::Scene& scene, const ViewOptions& options);
 
 }  // namespace swirl::view

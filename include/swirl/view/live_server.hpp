@@ -14,7 +14,13 @@
 // number of viewers) and wakes the sessions; a session sends the newest frame
 // it has not sent whenever its previous write is done, so a slow viewer skips
 // frames instead of queueing them, and the simulation thread never waits for
-// the network. Controls: each message is checked (parse_control); a bad one
+// the network. Surface meshes (publish_mesh) likewise, but only to the
+// sessions whose viewer turned the surface on (the surface control, kept per
+// session here; surface_viewers() counts them, so that a session makes
+// meshes only while someone wants them), alternating with frames when both
+// are new. A session that ends stops counting; when none wants meshes the
+// stored one is dropped, so that a viewer turning the surface on later never
+// gets a stale one. Controls: each message is checked (parse_control); a bad one
 // is dropped and logged (rate-limited), the session stays open; a message over
 // max_message bytes closes that session (Beast's read limit), nothing else.
 // Several viewers at once, each with its own session.
@@ -35,10 +41,12 @@ struct ServerOptions {
   std::uint16_t port = 0;       // 0: any free port (port() says which)
   std::string token;            // required in every URL when not empty
   std::size_t max_message = 1024;  // bytes a control message may have
+  bool surface_on_connect = false;  // a new viewer starts with the surface on (swirl view --surface)
 };
 
 struct ServerStats {
   std::uint64_t frames_sent = 0, bytes_sent = 0, controls = 0, dropped = 0, sessions = 0;
+  std::uint64_t meshes_sent = 0, mesh_bytes_sent = 0;
 };
 
 class LiveServer {
@@ -62,6 +70,10 @@ class LiveServer {
 
   // Thread-safe: the newest frame for every viewer.
   void publish(std::shared_ptr<const std::string> frame);
+  // Thread-safe: the newest surface mesh, for the viewers that want one.
+  void publish_mesh(std::shared_ptr<const std::string> mesh);
+  // Thread-safe: how many viewers have the surface on now.
+  std::size_t surface_viewers() const;
   // Thread-safe: a text message (JSON) to every viewer now, e.g. an error.
   void announce(std::string text);
   ServerStats stats() const;

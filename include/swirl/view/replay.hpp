@@ -26,7 +26,11 @@
 // frames are read, at most --fps), colour, and seek (a frame by its index).
 // A burst of seeks (a dragged slider) shows only the last; a seek is always
 // answered by a frame, also one to the frame shown. The push and the
-// live parameters are refused (logged, counted, told to the page). A frame
+// live parameters are refused (logged, counted, told to the page). The
+// surface (a fluid's run whose frames have masses: the scene's ρ0, else each
+// particle's density, gives the volumes) is made by a Mesher
+// (view/mesher.hpp) from each frame shown while some viewer has it on; a run
+// without one refuses the control (and --surface, at once). A frame
 // that cannot be read pauses the replay on the frame before, with an error
 // naming the file on the page and in the log.
 #pragma once

@@ -17,6 +17,30 @@
 // 16 bits per axis resolve a 1 m box to 15 µm, below any SPH spacing swirl
 // runs; 7 bytes a particle (35 000 particles: 245 kB a frame).
 //
+// Mesh (server → page), the fluid's surface of one state (a triangle mesh,
+// render/surface_mesh.hpp), sent only to the viewers that turned the surface
+// on (control 10), the newest only, like frames:
+//   offset  0  u32  magic "SWVM"
+//           4  u16  version (kMeshVersion)
+//           6  u16  index bytes b: 2 (u16 indices; only when V ≤ 65 536) or 4 (u32)
+//           8  u64  step (the state's, as in its frame; replay: the frame's index)
+//          16  f64  simulated time
+//          24  u32  vertex count V
+//          28  u32  triangle count T
+//          32  f32  lo x, y, z   the vertices' bounds: their quantisation box
+//          44  f32  hi x, y, z
+//          56  f32  the grid cell the mesh was made on (length)
+//          60  f32  the colour field's level (iso)
+//          64  u16 or u32 [3T]   vertex indices, three per triangle,
+//                                counter-clockwise seen from outside
+//       64+3bT u16[3V]  positions, x y z per vertex: lo + q/65535·(hi − lo)
+//    64+3bT+6V i8[3V]   unit outward normals, x y z per vertex: n/127
+// The indices come first so that each array starts aligned to its own type
+// (the page reads the message in place). 9 bytes a vertex plus 6 or 12 a
+// triangle (the dam break at 35 000 particles, cell 1 spacing: about 53 000
+// vertices and 105 000 triangles, 1.1 MB). A page checks the magic, version,
+// index width, length and every index (< V) before it draws a mesh.
+//
 // Control (page → server): one message, its first byte the kind, then a fixed
 // payload (f32 little-endian); any other length, kind or a non-finite or
 // out-of-range value is not a control: parse_control() says why, and the
@@ -31,6 +55,8 @@
 //             the new value (a scalar in x with y = z = 0; gravity's g as a
 //             vector). Whether the value lies in the parameter's range is the
 //             session's to check (view/parameters.hpp), not the wire's.
+//  10 surface u8 on (0 or 1): this viewer wants meshes (or no longer).
+//             Meshes are made only while some viewer wants them.
 // In a replay (`swirl view RUN_DIR`) a frame's step field holds the frame's
 // index in the run's series.
 #pragma once
@@ -45,6 +71,7 @@
 #include <vector>
 
 #include "swirl/core/vec3.hpp"
+#include "swirl/render/surface_mesh.hpp"
 
 namespace swirl::view {
 
@@ -52,6 +79,10 @@ inline constexpr std::uint32_t kFrameMagic = 0x46565753u;  // "SWVF" read as lit
 inline constexpr std::uint16_t kFrameVersion = 1;
 inline constexpr std::uint16_t kNoColour = 0xffff;
 inline constexpr std::size_t kFrameHeaderBytes = 60;
+
+inline constexpr std::uint32_t kMeshMagic = 0x4D565753u;  // "SWVM" read as little-endian u32
+inline constexpr std::uint16_t kMeshVersion = 1;
+inline constexpr std::size_t kMeshHeaderBytes = 64;
 
 // One picture's worth of state, gathered by the simulation thread.
 struct FrameData {
@@ -79,6 +110,28 @@ struct DecodedFrame {
 // Throws std::invalid_argument naming what is wrong with a message that is not a frame.
 DecodedFrame decode_frame(std::span<const std::uint8_t> message);
 
+// The message for the mesh of the state at `step` and `time` (see the
+// header): u16 indices when it has at most 65 536 vertices. Throws
+// std::invalid_argument when the mesh's arrays disagree, it has more vertices
+// or triangles than a u32 counts, or a vertex is not finite.
+std::string encode_mesh(const render::SurfaceMesh& mesh, std::uint64_t step, double time);
+
+// A mesh decoded back (tests, tools), positions and normals as the page
+// reconstructs them.
+struct DecodedMesh {
+  std::uint64_t step = 0;
+  double time = 0;
+  unsigned index_bytes = 4;
+  std::array<float, 3> lo{}, hi{};
+  float cell = 0, iso = 0;
+  std::vector<Vec3<float>> vertices, normals;
+  std::vector<std::uint32_t> indices;
+  std::size_t triangle_count() const { return indices.size() / 3; }
+};
+// Throws std::invalid_argument naming what is wrong with a message that is
+// not a mesh (magic, version, index width, length, bounds, an index ≥ V).
+DecodedMesh decode_mesh(std::span<const std::uint8_t> message);
+
 namespace control {
 struct Pause {};
 struct Resume {};
@@ -105,9 +158,12 @@ struct Parameter {
   ParameterId id = ParameterId::Viscosity;
   Vec3<float> value;  // a scalar parameter's value in x (y = z = 0)
 };
+struct Surface {
+  bool on = false;
+};
 }  // namespace control
 using Control = std::variant<control::Pause, control::Resume, control::Step, control::Reset, control::Speed,
-                             control::Colour, control::Push, control::Seek, control::Parameter>;
+                             control::Colour, control::Push, control::Seek, control::Parameter, control::Surface>;
 
 // A control message, or why it is not one (kind, length or value).
 struct Parsed {
