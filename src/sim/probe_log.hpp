@@ -62,6 +62,10 @@ class ProbeLog final : public Observer<Real> {
 
   std::string_view name() const override { return "probes"; }
   void on_start(Simulation<Real>& sim, bool resumed) override {
+    // DFSPH records its density solve's reaction on the walls from the first step on.
+    if (!obstacles_.empty())
+      for (const auto& s : sim.solvers())
+        if (auto* fluid = dynamic_cast<sph::SphFluid<Real>*>(s.get())) fluid->record_boundary_reactions(true);
     if (!resumed) add_row(sim);
   }
   void on_step(Simulation<Real>& sim) override {

@@ -134,6 +134,12 @@ Csv read_csv(const fs::path& file) {
 
 constexpr double kG = 9.81, kRho0 = 1000;
 
+sph::SphFluid<double>& fluid_of(Simulation<double>& sim) {
+  for (const auto& s : sim.solvers())
+    if (auto* f = dynamic_cast<sph::SphFluid<double>*>(s.get())) return *f;
+  throw std::logic_error("no SPH solver");
+}
+
 // 0.12 × 0.12 m of water 0.2 m deep (360 particles) at rest from t = 0:
 // DFSPH holds it up from the first step, and its column rings down over a
 // few tenths of a second. Rows from 0.2 s to 0.6 s are averaged.
@@ -183,7 +189,7 @@ point = [0.06, 0.06, 0.28]
   // Measured (2026-12-03): p̄ = 942.7 Pa, −3.9 % of ρ0 g d for the nominal
   // d = 0.1 m, −0.6 % for the depth below the gauge's mean surface (0.0967 m);
   // h̄ = 0.1967 m (the settled surface is s/6 below the lattice's 0.2 m);
-  // F̄_z = −28.31 N against a weight of 28.25 N (+0.2 %); |τ| ≤ 1.2e-3 N·m.
+  // F̄_z = −28.30 N against a weight of 28.25 N (+0.2 %); |τ| ≤ 1.2e-3 N·m.
   // The tolerances: 5 %, a quarter spacing, 2 %, and 1e-3 of the scales.
   EXPECT_NEAR(pressure, expected, 0.05 * expected);
   EXPECT_NEAR(height, depth, s / 4);
@@ -205,14 +211,15 @@ point = [0.06, 0.06, 0.28]
 // fluid's bottom layer pushes the side walls' lowest rows up while the
 // matching push down lands on the floor's edge rows. Only the sum over all the
 // walls is the weight (the previous test). Measured (2026-12-03): the 16
-// central floor particles −12.98 N against a column of 13.04 N (−0.5 %); the
-// whole floor −54.35 N, the side walls +4.16 N, the weight 50.23 N.
+// central floor particles −12.99 N against a column of 13.04 N (−0.4 %); the
+// whole floor −54.38 N, the side walls +4.17 N, the weight 50.23 N.
 TEST(ProbesHydrostatic, TheFloorCarriesTheWaterColumnAboveIt) {
   const double L = 0.16, depth = 0.2;
   const scene::Scene sc = scene::parse_scene(tank(L, depth, 0.35, ""), "scene.toml");
   Simulation<double> sim = sim::build_simulation<double>(sc);
   sim.start();
-  const auto& fluid = *sim.find_solver<sph::SphFluid<double>>();
+  sph::SphFluid<double>& fluid = fluid_of(sim);
+  fluid.record_boundary_reactions(true);  // as probes.csv has it
   const double h = sc.sph->smoothing_length;
   std::vector<double> f;
   double floor = 0, sides = 0, patch = 0;
@@ -295,6 +302,54 @@ TEST(ProbesHydrostatic, TheThesisSolversReactionBalancesTheFluidsMomentum) {
               worst, largest, weight);
   EXPECT_LT(worst, 1e-9 * weight);
   EXPECT_GT(largest, 0.5 * weight);  // the walls did hold the column
+}
+
+// DFSPH: the fluid's momentum changes over a step by Δt (M g − Σ_b F_b) when
+// F_b are the walls' reactions to the step's two pressure impulses (the
+// constant-density solve's recorded at the step's start, the divergence-free
+// solve's at its end): checked at every step to rounding, without viscosity
+// (whose next-step term is computed from the final velocities).
+TEST(ProbesHydrostatic, DfsphReactionBalancesTheFluidsMomentumChange) {
+  const double L = 0.12, depth = 0.2, dt = 0.005;
+  const std::string text = swap(tank(L, depth, 0.2, ""), "viscosity = 0.5", "viscosity = 0.0");
+  Simulation<double> sim = sim::build_simulation<double>(scene::parse_scene(text, "scene.toml"));
+  sim.start();
+  sph::SphFluid<double>* fluid = &fluid_of(sim);
+  fluid->record_boundary_reactions(true);
+  const auto momentum = [&] {
+    const ParticleSet<double>& p = sim.particles();
+    std::array<double, 3> m{};
+    for (std::size_t i = 0; i < p.size(); ++i)
+      for (int axis = 0; axis < 3; ++axis) m[static_cast<std::size_t>(axis)] += p.mass[i] * p.velocity[axis][i];
+    return m;
+  };
+  double fluid_mass = 0;
+  {
+    const ParticleSet<double>& p = sim.particles();
+    const std::int32_t* kind = p.int_field(p.find_int_field(kKindField)).data();
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (!is_boundary(kind[i])) fluid_mass += p.mass[i];
+  }
+  std::vector<double> f;
+  double worst = 0, largest = 0;
+  for (int k = 1; k <= 40; ++k) {
+    const auto before = momentum();
+    sim.step();
+    const auto after = momentum();
+    fluid->boundary_forces(sim.particles(), 64, f);
+    std::array<double, 3> walls{};
+    for (std::size_t i = 0; i < sim.particles().size(); ++i)
+      for (std::size_t axis = 0; axis < 3; ++axis) walls[axis] += f[3 * i + axis];
+    const std::array<double, 3> g{0, 0, -kG};
+    for (std::size_t axis = 0; axis < 3; ++axis)
+      worst = std::max(worst, std::abs((after[axis] - before[axis]) / dt - fluid_mass * g[axis] + walls[axis]));
+    largest = std::max(largest, std::abs(walls[2]));
+  }
+  const double weight = fluid_mass * kG;
+  std::printf("DFSPH: |dP/dt - M g + walls' reaction| <= %.3g N (walls' |F_z| up to %.3g N, weight %.3g N)\n", worst,
+              largest, weight);
+  EXPECT_LT(worst, 1e-9 * weight);
+  EXPECT_GT(largest, 0.5 * weight);
 }
 
 // A dam break against a named cylinder, DFSPH: probes.csv of a run stopped
