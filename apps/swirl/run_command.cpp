@@ -75,8 +75,9 @@ void check_outputs(const RunArgs& args, const std::filesystem::path& out_dir) {
     const fs::path rel = fs::absolute(json).lexically_normal().lexically_relative(fs::absolute(out_dir).lexically_normal());
     const std::string name = rel.string();
     if (rel.has_parent_path() ? rel.begin()->string() == "checkpoints" || rel.begin()->string() == "render"
-                              : name == "scene.toml" || name == "diagnostics.csv" || name == "manifest.txt" ||
-                                    name.rfind("particles", 0) == 0 || name == io::RunFolder::kLockFile)
+                              : name == "scene.toml" || name == "diagnostics.csv" || name == "probes.csv" ||
+                                    name == "manifest.txt" || name.rfind("particles", 0) == 0 ||
+                                    name == io::RunFolder::kLockFile)
       throw std::invalid_argument(fmt::format("--summary-json {}: the run writes that file in --out {}; choose another name",
                                               json.string(), out_dir.string()));
     outputs.push_back({"--summary-json", json});

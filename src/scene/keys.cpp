@@ -617,6 +617,18 @@ std::vector<SceneKey> declare_scene_keys() {
                      .doc = "the level of the colour field the surface is drawn at (`0.5`: where a flat fluid ends)",
                      .hashed = false},
             in_scene(&Scene::surface_iso)));
+  // probes.csv: keys added after checkpoints existed, left out of the hash at their defaults.
+  add(field(SceneKey{.key = "output.probes_interval", .section = "output", .unit = "s (simulated)", .range = kNonNegative,
+                     .doc = "how often `probes.csv` gets a row (the `[[probes]]`, and the obstacles' forces with "
+                            "`obstacle_forces`); `0`: at `output.interval` (docs/sph.md, Probes)",
+                     .unhashed_value = "0"},
+            in_scene(&Scene::probes_interval)));
+  add(field(SceneKey{.key = "output.obstacle_forces", .section = "output",
+                     .doc = "`probes.csv` also records the force and torque the fluid exerts on each obstacle (and on "
+                            "walls of particles, as `walls`): columns `<name>_force_x` ... `<name>_torque_z`, in N and "
+                            "N·m about the obstacle's centre (needs boundary particles)",
+                     .unhashed_value = "false"},
+            in_scene(&Scene::obstacle_forces)));
   return k;
 }
 
@@ -875,6 +887,20 @@ std::vector<SourceKey> obstacle_keys(ObstacleSource::Shape shape) {
                               .doc = "the distance between its boundary particles",
                               .default_doc = "the first `fluid_block`'s spacing", .custom_read = true},
                     in_source(&ObstacleSource::spacing)));
+  // Absent (empty) it is not in the hash: scenes from before the key keep theirs.
+  SourceKey name{.key = "name", .type = KeyType::Text,
+                 .doc = "its name in `probes.csv` (`output.obstacle_forces`): letters, digits and `_`, unique among "
+                        "the obstacles and probes",
+                 .default_doc = "`\"obstacle<k>\"`, k = 1, 2, ... over the obstacles in order"};
+  name.get = [](const ParticleSource& src) -> std::optional<KeyValue> {
+    const auto* o = std::get_if<ObstacleSource>(&src);
+    if (!o || o->name.empty()) return std::nullopt;
+    return KeyValue{std::string_view(o->name)};
+  };
+  name.set = [](ParticleSource& src, const KeyValue& v) {
+    if (auto* o = std::get_if<ObstacleSource>(&src)) o->name = std::string(std::get<std::string_view>(v));
+  };
+  k.push_back(std::move(name));
   return k;
 }
 
@@ -911,6 +937,39 @@ std::vector<SourceKind> declare_source_kinds() {
   for (auto& kind : kinds)
     for (auto& key : kind.keys) key.section = kind.name;
   return kinds;
+}
+
+using ProbeKey = KeySpec<Probe>;
+
+std::vector<ProbeKey> declare_probe_keys() {
+  std::vector<ProbeKey> k;
+  k.push_back(field(ProbeKey{.key = "name", .section = "probes",
+                             .doc = "the probe's name, the start of its columns in `probes.csv`: letters, digits and "
+                                    "`_`, unique among the probes and obstacles",
+                             .required = true},
+                    [](auto& p) { return &p.name; }));
+  k.push_back(field(ProbeKey{.key = "point", .section = "probes", .unit = "m",
+                             .doc = "a pressure probe here, inside the box: column `<name>_pressure` (Pa), the "
+                                    "Shepard-normalised kernel interpolation of the fluid particles' pressures",
+                             .default_doc = "–"},
+                    [](auto& p) { return &p.point; }));
+  ProbeKey line{.key = "line", .section = "probes", .type = KeyType::VectorList, .unit = "m",
+                .doc = "`[[x, y, z0], [x, y, z1]]`, z0 < z1, inside the box: a vertical water-height gauge, column "
+                       "`<name>_height` (m above z0), where the fluid's kernel sum Σ V_j W falls below 0.5; give "
+                       "`point` or `line`",
+                .default_doc = "–", .custom_read = true};
+  line.get = [](const Probe& p) -> std::optional<KeyValue> {
+    if (p.line.empty()) return std::nullopt;
+    return KeyValue{p.line};
+  };
+  line.set = [](Probe& p, const KeyValue& v) { p.line = std::get<std::vector<Vec3d>>(v); };
+  k.push_back(std::move(line));
+  return k;
+}
+
+const std::vector<ProbeKey>& probe_key_list() {
+  static const std::vector<ProbeKey> keys = declare_probe_keys();
+  return keys;
 }
 
 const std::vector<SceneKey>& scene_key_list() {
@@ -1000,9 +1059,11 @@ constexpr std::string_view kRegionClose = "<!-- /scene-keys -->";
 
 std::span<const KeySpec<Scene>> scene_keys() { return scene_key_list(); }
 
+std::span<const KeySpec<Probe>> probe_keys() { return probe_key_list(); }
+
 std::span<const std::string_view> scene_sections() {
-  static constexpr std::string_view sections[] = {"simulation", "box", "forces", "sph", "random_box",
-                                                  "nbody",      "output", "particles"};
+  static constexpr std::string_view sections[] = {"simulation", "box",    "forces",    "sph",   "random_box",
+                                                  "nbody",      "output", "particles", "probes"};
   return sections;
 }
 
@@ -1089,6 +1150,10 @@ std::string key_table_markdown(std::string_view section) {
     for (std::size_t i = 0; i < source_kinds().size(); ++i)
       kinds += fmt::format("{}`\"{}\"`", i ? ", " : "", source_kinds()[i].name);
     return out + fmt::format("| `kind` | string | – | required | {}: the kind of source, below |\n", kinds);
+  }
+  if (section == "probes") {
+    for (const auto& spec : probe_keys()) out += row(spec, spec.key, Probe{});
+    return out;
   }
   for (const auto& kind : source_kinds()) {
     if (kind.name != section) continue;

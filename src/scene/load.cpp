@@ -620,6 +620,36 @@ void read_particles(const Table& top, Scene& s) {
   resolve_boundary_spacing(top, s, fluid_spacing);
 }
 
+// [[probes]]: each a name and a point or a vertical line. Where a probe may
+// be (inside the box, vertical, names unique) is validate()'s.
+void read_probes(const Table& top, Scene& s) {
+  const Reader& r = top.reader();
+  const auto* node = top.find("probes");
+  if (!node) return;
+  const auto& list = r.array(*node, "probes", "an array of tables ([[probes]])");
+  std::vector<std::string_view> known;
+  for (const auto& spec : probe_keys()) known.push_back(spec.key);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = fmt::format("probes[{}]", i);
+    if (!list[i].is_table()) r.wrong_type(where, "a table", list[i]);
+    const Table t(r, list[i].as_table(), where);
+    t.only(known, "unknown key for a probe");
+    Probe probe;
+    for (const auto& spec : probe_keys())
+      if (!spec.custom_read) t.read(spec, spec.key, probe);
+    if (const auto* line = t.find("line")) {
+      const auto& ends = r.array(*line, t.key("line"), "an array of two [x, y, z] points");
+      if (ends.size() != 2)
+        t.fail("line", fmt::format("expected two points, the lower and the upper end, got {}", ends.size()));
+      for (std::size_t k = 0; k < 2; ++k) probe.line.push_back(r.vec3(ends[k], fmt::format("{}[{}]", t.key("line"), k)));
+    }
+    if (probe.point && !probe.line.empty())
+      t.fail("line", fmt::format("cannot be given together with {}: a probe is a point or a line", t.key("point")));
+    if (!probe.point && probe.line.empty()) t.need("point", fmt::format(" (give point or {})", t.key("line")));
+    s.probes.push_back(std::move(probe));
+  }
+}
+
 Scene read_scene(const toml::table& root, std::string_view file) {
   const Reader r(file);
   const Table top(r, &root, "");
@@ -645,6 +675,7 @@ Scene read_scene(const toml::table& root, std::string_view file) {
   read_output(top.table("output"), s);
   resolve_time_step(top.table("simulation"), s);
   read_particles(top, s);
+  read_probes(top, s);
   validate(s);
   return s;
 }
@@ -752,6 +783,11 @@ std::string canonical_text(const Scene& s) {
     for (const auto& spec : kind.keys)
       if (const auto value = spec.hashed ? spec.get(source) : std::nullopt)
         out += fmt::format("{} = {}\n", spec.key, value_text(*value, true));
+  }
+  for (const auto& probe : s.probes) {
+    out += "[[probes]]\n";
+    for (const auto& spec : probe_keys())
+      if (const auto value = spec.get(probe)) out += fmt::format("{} = {}\n", spec.key, value_text(*value, true));
   }
   return out;
 }

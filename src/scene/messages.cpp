@@ -94,6 +94,7 @@ void check_value(const KeySpec<Owner>& spec, const KeyValue& value, std::string_
 }
 
 template void check_value<Scene>(const KeySpec<Scene>&, const KeyValue&, std::string_view, std::string_view);
+template void check_value<Probe>(const KeySpec<Probe>&, const KeyValue&, std::string_view, std::string_view);
 template void check_value<ParticleSource>(const KeySpec<ParticleSource>&, const KeyValue&, std::string_view,
                                           std::string_view);
 

@@ -341,6 +341,23 @@ std::size_t count_particles(const Scene& scene) {
                                                          : static_cast<std::size_t>(total);
 }
 
+std::vector<ObstacleIds> obstacle_ids(const Scene& scene) {
+  std::vector<ObstacleIds> out;
+  std::uint64_t first = 0;
+  std::size_t k = 0;
+  for (const auto& source : scene.sources) {
+    const std::uint64_t n = detail::source_count(source);
+    if (const auto* o = std::get_if<ObstacleSource>(&source)) {
+      ++k;
+      out.push_back({o->name.empty() ? fmt::format("obstacle{}", k) : o->name, first, n, obstacle_centre(*o)});
+    }
+    first = detail::add_sat(first, n);
+  }
+  if (scene.walls && scene.wall_kind == Walls::Particles)
+    out.push_back({"walls", first, detail::wall_count(scene), (scene.box.lo + scene.box.hi) * 0.5});
+  return out;
+}
+
 template <class Real>
 ParticleSet<Real> make_particles(const Scene& scene) {
   const std::uint64_t count = total_count(scene);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -167,6 +169,61 @@ class Checker {
     if (total > detail::kMaxParticles)
       fail("particles", fmt::format("the sources make {} particles in total, more than the limit of {} (2^31)",
                                     count_text(total), detail::kMaxParticles));
+  }
+
+  // [[probes]] and output.obstacle_forces (docs/sph.md, Probes): the fluid's,
+  // inside the box, lines vertical, names usable as CSV column prefixes and
+  // unique among the probes and the obstacles (whose default names count too).
+  void probes() const {
+    if (s_.obstacle_forces && !s_.has_boundary_particles())
+      fail("output.obstacle_forces", "the scene has no boundary particles to measure (no obstacle_* source, and "
+                                     "box.walls is not \"particles\")");
+    std::vector<std::pair<std::string, std::string>> names;  // name, where it was given
+    const auto add_name = [&](const std::string& name, const std::string& where) {
+      if (name.empty() || name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") !=
+                              std::string::npos)
+        fail(where, fmt::format("'{}' is not a usable name: letters, digits and _ only (it starts columns of probes.csv)",
+                                name));
+      for (const auto& [other, at] : names)
+        if (other == name) fail(where, fmt::format("the name '{}' is already taken by {}", name, at));
+      names.emplace_back(name, where);
+    };
+    if (s_.obstacle_forces) {
+      std::size_t k = 0;
+      for (std::size_t i = 0; i < s_.sources.size(); ++i)
+        if (const auto* o = std::get_if<ObstacleSource>(&s_.sources[i])) {
+          ++k;
+          add_name(o->name.empty() ? fmt::format("obstacle{}", k) : o->name,
+                   fmt::format("particles[{}].name{}", i, o->name.empty() ? " (its default)" : ""));
+        }
+      if (s_.walls && s_.wall_kind == Walls::Particles) add_name("walls", "box.walls (the walls' name)");
+    }
+    for (std::size_t i = 0; i < s_.probes.size(); ++i) {
+      const Probe& probe = s_.probes[i];
+      const std::string where = fmt::format("probes[{}]", i);
+      for (const auto& spec : probe_keys())
+        if (const auto value = spec.get(probe)) detail::check_value(spec, *value, file_, fmt::format("{}.{}", where, spec.key));
+      if (!s_.sph) fail(fmt::format("{}.name", where), "a probe samples the SPH fluid: the scene needs an [sph] section");
+      add_name(probe.name, fmt::format("{}.name", where));
+      if (probe.point.has_value() == !probe.line.empty())
+        fail(where, "give exactly one of point and line");
+      if (probe.point) {
+        inside(*probe.point, fmt::format("{}.point", where));
+        continue;
+      }
+      if (probe.line.size() != 2) fail(fmt::format("{}.line", where), "expected two points, the lower and the upper end");
+      const Vec3d& a = probe.line[0];
+      const Vec3d& b = probe.line[1];
+      if (a.x != b.x || a.y != b.y)
+        fail(fmt::format("{}.line", where),
+             fmt::format("must be vertical (a water-height gauge): its ends {} and {} differ in x or y",
+                         detail::vec_text(a), detail::vec_text(b)));
+      if (!(a.z < b.z))
+        fail(fmt::format("{}.line", where),
+             fmt::format("the first point is the lower end: z0 = {} must be below z1 = {}", a.z, b.z));
+      inside(a, fmt::format("{}.line[0]", where));
+      inside(b, fmt::format("{}.line[1]", where));
+    }
   }
 
  private:
@@ -361,6 +418,7 @@ void validate(const Scene& scene) {
   check.output();
   check.sources();
   check.boundary();
+  check.probes();
 }
 
 double dense_cell_table_keys(const Scene& scene) {

@@ -27,6 +27,7 @@
 #include "swirl/scene/validate.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/observer.hpp"
+#include "probe_log.hpp"
 
 namespace swirl::sim {
 namespace {
@@ -691,7 +692,11 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   const std::string_view time_unit = scene.units == scene::Units::SI ? "s" : "";  // a literal: outlives the run
   summary.time_unit = std::string(time_unit);
   auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps, time_unit);
-  std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get(), guard.get()};
+  std::unique_ptr<ProbeLog<Real>> probes;
+  if (scene.has_probe_output()) probes = std::make_unique<ProbeLog<Real>>(scene, options, folder);
+  std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get()};
+  if (probes) observers.push_back(probes.get());
+  observers.push_back(guard.get());
   for (const auto& o : added) observers.push_back(o.get());
   auto collect = [&](NamedValues& values) {
     end.save(values);
@@ -818,6 +823,9 @@ std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<
   }
   if (particles.find_int_field(kKindField) != ParticleSet<Real>::npos)
     return "boundary particles (box.walls = \"particles\", obstacles)";
+  // probes.csv samples the whole set on one rank; on ranks it would need the
+  // gathered state every probe row (docs/sph.md, Probes).
+  if (scene.has_probe_output()) return "probes ([[probes]], output.obstacle_forces)";
   return {};
 }
 

@@ -116,6 +116,11 @@ cat "$out/stderr"
 on_ranks 2 run "$examples/plummer.toml" --set 'nbody.method="fmm"' --steps 2 --out "$out/refused"
 [ "$status" -eq 2 ] || fail "the FMM on 2 ranks: status $status (want 2)"
 grep -q 'nbody.method = "fmm" does not run on several MPI ranks yet' "$out/stderr" || fail "the FMM on 2 ranks: not said why"
+on_ranks 2 run "$scene" "${small[@]}" --set 'probes=[{name="p", point=[0.1, 0.1, 0.05]}]' --steps 2 --out "$out/refused"
+[ "$status" -eq 2 ] || fail "probes on 2 ranks: status $status (want 2)"
+grep -q 'probes (\[\[probes\]\], output.obstacle_forces) does not run on several MPI ranks yet' "$out/stderr" ||
+  fail "probes on 2 ranks: not said why"
+[ ! -e "$out/refused" ] || fail "probes on 2 ranks: the refused run created its folder"
 
 # 7. The folder's lock and files are rank 0's: a second run into a folder
 #    holding another run is refused on every rank with status 2.

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <string>
 #include <vector>
 
 #include "swirl/core/particle_set.hpp"
@@ -38,6 +40,22 @@ double wall_offset(const Scene& scene);
 // box grown by wall_offset() on every side, sampled as an obstacle_box at
 // scene.wall_spacing; empty for other scenes.
 std::vector<Vec3d> wall_points(const Scene& scene);
+
+// The particles of one obstacle by their ids: make_particles() numbers the
+// particles 0..N−1 in source order, the walls' last, and an id travels with
+// its particle through every reorder and checkpoint, so the ids
+// [first, first + count) are the obstacle's for the whole run (checkpoints
+// need no field of their own for it). `centre` is the point torques are taken
+// about (obstacle_centre(); the box's centre for the walls).
+struct ObstacleIds {
+  std::string name;  // its `name`, or "obstacle<k>" (k from 1, in source order); "walls" for the walls
+  std::uint64_t first = 0;
+  std::uint64_t count = 0;
+  Vec3d centre{};
+};
+
+// Every obstacle in source order, then the walls (box.walls = "particles").
+std::vector<ObstacleIds> obstacle_ids(const Scene& scene);
 
 extern template ParticleSet<float> make_particles<float>(const Scene&);
 extern template ParticleSet<double> make_particles<double>(const Scene&);

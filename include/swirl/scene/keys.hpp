@@ -102,7 +102,11 @@ struct SourceKind {
 // Every section key, in the order of docs/scenes.md and of the scene hash's text.
 std::span<const KeySpec<Scene>> scene_keys();
 
-// The section tables, in order ("" is the root); `particles` is the array of sources.
+// The keys of one [[probes]] table.
+std::span<const KeySpec<Probe>> probe_keys();
+
+// The section tables, in order ("" is the root); `particles` is the array of
+// sources, `probes` the array of probes.
 std::span<const std::string_view> scene_sections();
 
 // Every kind of [[particles]] source, in the order of the `kind` names.

@@ -168,6 +168,31 @@ struct ObstacleSource {
   Vec3d normal{0, 0, 1};    // plane: its normal (any length > 0)
   double spacing = 0;       // m, > 0 once loaded (load_scene: the first fluid_block's when not given)
   Box<double> clip;         // plane: the box it is clipped to (load_scene: the scene's box)
+  // Its name in probes.csv (output.obstacle_forces); empty: "obstacle<k>", k
+  // counting the scene's obstacles from 1 in source order.
+  std::string name;
+};
+
+// The point about which an obstacle's torque is taken (probes.csv): the
+// centre of its box, its sphere's centre, the middle of its cylinder's axis,
+// its plane's point.
+inline Vec3d obstacle_centre(const ObstacleSource& o) {
+  switch (o.shape) {
+    case ObstacleSource::Shape::Box: return (o.region.lo + o.region.hi) * 0.5;
+    case ObstacleSource::Shape::Sphere: return o.center;
+    case ObstacleSource::Shape::Cylinder: return (o.start + o.end) * 0.5;
+    case ObstacleSource::Shape::Plane: return o.point;
+  }
+  return o.point;
+}
+
+// A probe ([[probes]]; docs/sph.md, Probes): a named point where the SPH
+// interpolation of the fluid's pressure is recorded, or a vertical line along
+// which the water height is found, written to probes.csv in the run folder.
+struct Probe {
+  std::string name;            // [A-Za-z0-9_]+, unique among the probes and obstacles
+  std::optional<Vec3d> point;  // a point probe: where (m)
+  std::vector<Vec3d> line;     // a line probe: its lower and upper end (m), same x and y; empty otherwise
 };
 
 // The obstacle shapes' names, which are also their [[particles]] kinds.
@@ -239,6 +264,12 @@ struct Scene {
   double surface_radius = 2.0;             // output.surface_radius, spacings
   double surface_cell = 0.5;               // output.surface_cell, spacings
   double surface_iso = 0.5;                // output.surface_iso, in (0, 1)
+  // probes.csv (docs/sph.md, Probes): the probes' interval (0: output.interval)
+  // and whether it records the force and torque the fluid exerts on every
+  // obstacle and on walls of particles.
+  double probes_interval = 0;              // output.probes_interval, s of simulated time
+  bool obstacle_forces = false;            // output.obstacle_forces
+  std::vector<Probe> probes;               // [[probes]]
 
   std::vector<ParticleSource> sources;     // [[particles]]; a "fluid_block" becomes a LatticeSource
                                            // whose mass gives the rest density (sph::lattice_mass_for_density)
@@ -264,6 +295,9 @@ struct Scene {
   // that would overshoot end_time by less than 1e-9·dt is not added). With
   // adaptive steps and an end_time, the fewest steps (all of dt_max).
   std::uint64_t total_steps() const;
+
+  // True when the run writes probes.csv: probes, or the obstacles' forces.
+  bool has_probe_output() const { return !probes.empty() || obstacle_forces; }
 
   // True when the scene has boundary particles (box.walls = "particles" or an obstacle source).
   bool has_boundary_particles() const {

@@ -134,6 +134,8 @@ class DfsphStepper final : public integrate::Stepper<Real> {
       std::optional<ScopedPhase> phase;
       if (r.timers) phase.emplace(*r.timers, "dfsph.density");
       last_density_ = solve(p, dt, bs, Solve::Density);
+      // The walls' share of that solve's impulse, while x, ρ and the grid are the ones it used.
+      if (fluid_.records_boundary_reactions()) fluid_.record_density_reaction(p, bs);
     }
     {
       std::optional<ScopedPhase> phase;

@@ -247,6 +247,118 @@ class SphFluid final : public Solver<Real> {
     if (params_.viscosity > 0) dfsph_add_viscosity(grid_, p, SphLaws<Real>(params_), block_size, kinds(p));
   }
 
+  // DFSPH: record, after every constant-density solve, the reaction of its
+  // impulse on the boundary particles (record_density_reaction()), so that
+  // boundary_forces() has it exactly. Off by default (it costs a gather over
+  // the boundary particles per step); probes.csv with obstacle forces turns
+  // it on before the first step. Changes nothing in the simulation.
+  void record_boundary_reactions(bool on) { record_reactions_ = on; }
+  bool records_boundary_reactions() const { return record_reactions_ && dfsph(); }
+
+  // DFSPH, right after the constant-density solve (x, ρ and the grid still
+  // those of the step's start, κ the solve's final one): the reaction of the
+  // walls' part of its impulse, F_b = Σ_j m_j ψ_b (κ_j/ρ_j) ∇W_jb (the
+  // solve's velocity change of j is linear in κ, so this is the sum over its
+  // iterations and its warm start), kept by id until the next step.
+  void record_density_reaction(const ParticleSet<Real>& p, std::size_t block_size) {
+    const std::int32_t* kind = kinds(p);
+    if (!kind || !kernel_) return;
+    const std::size_t k1 = p.find_field(kKappaField);
+    if (k1 == ParticleSet<Real>::npos) throw std::logic_error("SPH: the constant-density solve's κ is not declared");
+    std::uint64_t ids = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) ids = std::max<std::uint64_t>(ids, std::uint64_t(p.id[i]) + 1);
+    density_reaction_.assign(3 * ids, 0.0);
+    const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
+    const Real *rho = p.density.data(), *kappa = p.extra(k1).data();
+    double* out = density_reaction_.data();
+    parallel::for_blocks_pinned("sph_boundary_reaction", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
+        if (!is_boundary(kind[i])) return;
+        double fx = 0, fy = 0, fz = 0;
+        detail::for_each_pair(x, y, z, i, ranges, count, kernel_->h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (is_boundary(kind[j])) return;
+          const double dx = double(x[j]) - double(x[i]), dy = double(y[j]) - double(y[i]), dz = double(z[j]) - double(z[i]);
+          const double r = std::sqrt(double(r2));
+          if (!(r > 0)) return;
+          const double c = double(m[j]) * double(m[i]) * double(kappa[j]) / double(rho[j]) * double(kernel_->gradient(Real(r)));
+          fx += c * dx, fy += c * dy, fz += c * dz;
+        });
+        const std::size_t at = 3 * std::size_t(p.id[i]);
+        out[at] = fx, out[at + 1] = fy, out[at + 2] = fz;
+      });
+    });
+  }
+
+  // The force the fluid exerts on each boundary particle (N; docs/sph.md,
+  // Probes), into f[3i], f[3i+1], f[3i+2] (0 for a fluid particle): the
+  // reaction of the pair law on the fluid particles j within h,
+  //   F_b = −Σ_j m_j a_j←b,
+  // evaluated on the current state with the grid of the last evaluation
+  // (between steps x, ρ, p are that evaluation's; the viscosity uses the
+  // current v). The thesis's solver: a_j←b = norm_p (p_j + p_b) V_b (h − r)²/r
+  // r⃗_jb / ρ_j + norm_μ V_b (h − r)(0 − v_j) / ρ_j, V_b = ψ_b/ρ0 (without the
+  // gradient correction, when that is on). DFSPH: the last step's pressure
+  // impulses over Δt, a_j←b = −ψ_b (κ_j/ρ_j) ∇W_jb: the divergence-free
+  // solve's κ^v at the current x, and the constant-density solve's as recorded
+  // at the step's start (record_boundary_reactions(); when it is off, its κ
+  // taken at the current x, an approximation); plus the same viscosity. A
+  // gather into b over the grid: the same bits for any thread count. Needs a
+  // grid evaluation (boundary particles always have one).
+  void boundary_forces(const ParticleSet<Real>& p, std::size_t block_size, std::vector<double>& f) const {
+    f.assign(3 * p.size(), 0.0);
+    const std::int32_t* kind = kinds(p);
+    if (!kind || p.empty()) return;
+    if (!used_grid_ || (dfsph() && !kernel_))
+      throw std::logic_error("SPH: boundary forces before an evaluation on the grid");
+    const SphLaws<Real> laws(params_);
+    const double rho0 = params_.rest_density;
+    const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
+    const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
+    const Real *rho = p.density.data(), *pr = p.pressure.data();
+    const Real *kappa = nullptr, *kappa_v = nullptr;
+    if (dfsph()) {
+      const std::size_t k1 = p.find_field(kKappaField), k2 = p.find_field(kKappaVField);
+      if (k1 == ParticleSet<Real>::npos || k2 == ParticleSet<Real>::npos)
+        throw std::logic_error("SPH: boundary forces without DFSPH's κ fields");
+      kappa = p.extra(k1).data(), kappa_v = p.extra(k2).data();
+    }
+    const double norm_p = double(laws.pressure.norm), norm_v = double(laws.viscosity.norm);
+    // Before the first step nothing is recorded, and κ is 0 anyway.
+    const bool recorded = records_boundary_reactions();
+    double* out = f.data();
+    parallel::for_blocks_pinned("sph_boundary_forces", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
+        if (!is_boundary(kind[i])) return;
+        const double volume = double(m[i]) / rho0;  // V_b = ψ_b/ρ0
+        double fx = 0, fy = 0, fz = 0;
+        detail::for_each_pair(x, y, z, i, ranges, count, laws.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (is_boundary(kind[j])) return;
+          // r⃗_jb = x_j − x_b, in double from the same positions.
+          const double dx = double(x[j]) - double(x[i]), dy = double(y[j]) - double(y[i]), dz = double(z[j]) - double(z[i]);
+          const double r = std::sqrt(double(r2)), mj = double(m[j]), rj = double(rho[j]);
+          const double q = std::max(double(laws.h) - r, 0.0);
+          double radial = 0;  // a_j←b = radial · r⃗_jb + viscous · (0 − v_j)
+          if (dfsph()) {
+            const double k = double(kappa_v[j]) + (recorded ? 0.0 : double(kappa[j]));
+            radial = r > 0 ? -double(m[i]) * k / rj * double(kernel_->gradient(Real(r))) : 0.0;
+          } else {
+            radial = r > 0 ? norm_p * (double(pr[j]) + double(pr[i])) * volume * q * q / r / rj : 0.0;
+          }
+          const double viscous = norm_v * volume * q / rj;
+          fx -= mj * (radial * dx - viscous * double(vx[j]));
+          fy -= mj * (radial * dy - viscous * double(vy[j]));
+          fz -= mj * (radial * dz - viscous * double(vz[j]));
+        });
+        if (recorded) {
+          const std::size_t at = 3 * std::size_t(p.id[i]);
+          if (at + 2 < density_reaction_.size())
+            fx += density_reaction_[at], fy += density_reaction_[at + 1], fz += density_reaction_[at + 2];
+        }
+        out[3 * i] = fx, out[3 * i + 1] = fy, out[3 * i + 2] = fz;
+      });
+    });
+  }
+
   // The particles' kinds (core/particle_kind.hpp), or null when all are fluid.
   static const std::int32_t* kinds(const ParticleSet<Real>& p) {
     const std::size_t k = p.find_int_field(kKindField);
@@ -637,6 +749,8 @@ class SphFluid final : public Solver<Real> {
   std::uint64_t evaluations_ = 0;
   bool used_grid_ = false;
   bool boundary_volumes_ = false;  // ψ_b computed into the boundary particles' masses (state)
+  bool record_reactions_ = false;  // DFSPH: record_density_reaction() after each density solve
+  std::vector<double> density_reaction_;  // DFSPH: its result, 3 per id (scratch: a step recomputes it)
   bool counted_ = false;           // fluid_count_ set
   std::size_t fluid_count_ = 0;    // fluid particles (static: boundary particles are never added or removed)
 };
