@@ -160,6 +160,16 @@ std::vector<Bytes> Communicator::all_gather(const Bytes& mine) const {
   return {mine};
 }
 
+std::string Communicator::first_text(const std::string& mine) const {
+  if (!distributed()) return mine;
+  // No copy from an empty string's data (it may be null).
+  const auto* first = reinterpret_cast<const std::byte*>(mine.data());
+  const Bytes bytes = mine.empty() ? Bytes() : Bytes(first, first + mine.size());
+  for (const Bytes& b : all_gather(bytes))
+    if (!b.empty()) return std::string(reinterpret_cast<const char*>(b.data()), b.size());
+  return {};
+}
+
 std::vector<Bytes> Communicator::gather_to_root(const Bytes& mine) const {
 #if SWIRL_WITH_MPI
   if (mpi_) {

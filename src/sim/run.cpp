@@ -565,19 +565,6 @@ std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<R
                                 summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
 }
 
-// A text as bytes to send (no copy call for an empty one: its data may be null).
-dist::Bytes as_bytes(const std::string& text) {
-  const auto* first = reinterpret_cast<const std::byte*>(text.data());
-  return dist::Bytes(first, first + text.size());
-}
-
-// On several ranks: the checkpoint rank 0 chose (read_newest_checkpoint), read
-// by every other rank whole (Simulation::resume keeps its share).
-std::filesystem::path agree_on_path(const dist::Communicator& comm, const std::filesystem::path& mine) {
-  const std::vector<dist::Bytes> all = comm.all_gather(as_bytes(mine.string()));
-  return std::string(reinterpret_cast<const char*>(all[0].data()), all[0].size());
-}
-
 // What stopped a stage of the loop: a blow-up, a failed write; empty: nothing.
 struct Failure {
   std::string error;
@@ -589,14 +576,10 @@ struct Failure {
 // the words of the lowest rank that failed.
 Failure agree(const dist::Communicator& comm, const Failure& mine) {
   if (!comm.distributed()) return mine;
-  const std::string text = mine.error.empty() ? std::string() : mine.blow_up + '\n' + mine.error;
-  for (const dist::Bytes& b : comm.all_gather(as_bytes(text))) {
-    if (b.empty()) continue;
-    const std::string all(reinterpret_cast<const char*>(b.data()), b.size());
-    const auto cut = all.find('\n');
-    return {all.substr(cut + 1), all.substr(0, cut)};
-  }
-  return {};
+  const std::string all = comm.first_text(mine.error.empty() ? std::string() : mine.blow_up + '\n' + mine.error);
+  if (all.empty()) return {};
+  const auto cut = all.find('\n');
+  return {all.substr(cut + 1), all.substr(0, cut)};
 }
 
 template <class Real>
@@ -712,7 +695,8 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     std::pair<io::CheckpointHeader, NamedValues> read;
     on_root([&] { read = read_newest_checkpoint(sim, *folder, hash, summary); });
     if (on_ranks) {
-      const std::filesystem::path file = agree_on_path(comm, summary.last_checkpoint);
+      // The checkpoint rank 0 chose, read whole by every other rank (resume() keeps its share).
+      const std::filesystem::path file = comm.first_text(root ? summary.last_checkpoint.string() : std::string());
       if (!root) read.first = io::read_checkpoint(file, sim.particles(), read.second);
       summary.last_checkpoint = file;
     }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <string>
 #include <vector>
 
 namespace swirl::dist {
@@ -52,6 +53,18 @@ TEST(Communicator, AllGatherGivesEveryRankEveryRanksBytesInRankOrder) {
   const std::vector<Bytes> all = comm.all_gather(mine);
   ASSERT_EQ(all.size(), static_cast<std::size_t>(comm.size()));
   for (std::size_t s = 0; s < all.size(); ++s) EXPECT_EQ(all[s], Bytes(3 * s, std::byte(s + 1)));
+}
+
+TEST(Communicator, FirstTextIsTheLowestRankWithText) {
+  const Communicator& comm = Communicator::world();
+  // Nobody has text: empty everywhere.
+  EXPECT_EQ(comm.first_text(""), "");
+  // Every rank from 1 on (or rank 0 alone on one rank) has text: the lowest one's.
+  const int speaker = comm.size() > 1 ? 1 : 0;
+  const std::string mine = comm.rank() >= speaker ? "rank " + std::to_string(comm.rank()) : std::string();
+  EXPECT_EQ(comm.first_text(mine), "rank " + std::to_string(speaker));
+  // Only the last rank speaks.
+  EXPECT_EQ(comm.first_text(comm.rank() == comm.size() - 1 ? "last" : ""), "last");
 }
 
 TEST(Communicator, GatherToRootKeepsRankOrder) {

@@ -19,6 +19,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <span>
+#include <string>
 #include <vector>
 
 namespace swirl::dist {
@@ -51,6 +52,11 @@ class Communicator {
 
   // Every rank's bytes on every rank, in rank order (each rank's may differ in length).
   std::vector<Bytes> all_gather(const Bytes& mine) const;
+
+  // The text of the lowest rank whose text is not empty, on every rank (empty
+  // when every rank's is): a failure's words, the owner's description of a
+  // particle, rank 0's choice of a file (the other ranks passing "").
+  std::string first_text(const std::string& mine) const;
 
   // Every rank's bytes on rank 0, in rank order (other ranks get an empty list).
   std::vector<Bytes> gather_to_root(const Bytes& mine) const;

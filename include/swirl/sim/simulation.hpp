@@ -141,8 +141,9 @@ class Simulation {
 
   // The whole state in the one-rank memory order, for frames and checkpoints.
   // Collective on several ranks: there rank 0 gets every particle (gathered
-  // once per step and order, and kept until the next gather: rank 0 holds a
-  // second copy of the whole set) and the other ranks an empty set.
+  // once per step and order, and freed when the next step starts: rank 0
+  // holds a second copy of the whole set only while the writers of a step
+  // use it) and the other ranks an empty set.
   const ParticleSet<Real>& whole_particles() const {
     if (!ranks_) return particles_;
     const auto stamp = std::make_pair(clock_.step, epoch());
@@ -237,6 +238,8 @@ class Simulation {
   // runs shorten the step so that it ends exactly at land_at if it would pass it.
   void step(std::optional<double> land_at = {}) {
     if (!started_) throw std::logic_error("Simulation::step() before start()");
+    // Rank 0's gathered copy of the whole set served this step's writers: free it.
+    if (gathered_valid_) gathered_ = ParticleSet<Real>(), gathered_valid_ = false;
     double dt_step = settings_.dt, t_next = time_of(clock_.step + 1);
     if (settings_.adaptive) {
       const double proposal = proposed_dt();
@@ -474,10 +477,8 @@ class Simulation {
     const std::uint64_t first = ranks_->first_global_index();
     std::string mine;
     if (index >= first && index < first + particles_.size()) mine = make(static_cast<std::size_t>(index - first));
-    const auto* text = reinterpret_cast<const std::byte*>(mine.data());
-    for (const dist::Bytes& part : ranks_->comm().all_gather(dist::Bytes(text, text + mine.size())))
-      if (!part.empty()) return std::string(reinterpret_cast<const char*>(part.data()), part.size());
-    return "?";
+    std::string text = ranks_->comm().first_text(mine);
+    return text.empty() ? "?" : text;
   }
 
   void evaluate_limits() {
