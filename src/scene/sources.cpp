@@ -11,6 +11,7 @@
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/core/random.hpp"
 #include "swirl/scene/initial_conditions.hpp"
+#include "swirl/scene/mesh_sampling.hpp"
 #include "swirl/sph/lattice_mass.hpp"
 
 namespace swirl::scene {
@@ -112,6 +113,7 @@ std::uint64_t obstacle_count(const ObstacleSource& s) {
       if (!(reach < 0x1p15)) return kSaturated;
       return obstacle_points(s).size();
     }
+    case Shape::Mesh: return mesh_point_count(s);
   }
   return 0;
 }
@@ -367,6 +369,7 @@ std::vector<Vec3d> obstacle_points(const ObstacleSource& s) {
   const double spacing = s.spacing;
   std::vector<Vec3d> out;
   if (!(spacing > 0)) return out;
+  if (s.shape == Shape::Mesh) return mesh_points(s);  // bounded by kMaxMeshParticles
   if (s.shape != Shape::Plane && detail::obstacle_count(s) > detail::kMaxParticles) return out;
   switch (s.shape) {
     case Shape::Box: return box_surface(s.region, spacing);
@@ -412,6 +415,7 @@ std::vector<Vec3d> obstacle_points(const ObstacleSource& s) {
         }
       return out;
     }
+    case Shape::Mesh: break;  // above
   }
   return out;
 }
