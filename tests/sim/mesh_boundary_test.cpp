@@ -94,8 +94,8 @@ class MeshBoundary : public ::testing::Test {
 
 // DFSPH: no fluid particle ever inside the block, checked after every step.
 // The thesis's solver: a one-layer shell is not always enough (docs/sph.md,
-// "Mesh obstacles"): at dt_max = 4e-4 none entered, but of seven dt_max from
-// 3.2e-4 to 5.6e-4 one (5.2e-4) let one particle through the low step's top,
+// "Mesh obstacles"): at dt_max = 4e-4 none entered, but of twelve dt_max from
+// 2.8e-4 to 1e-3 one (5.2e-4) let one particle through the low step's top,
 // where it then stayed. What holds there, and is tested: the fluid stays out
 // but for at most 1 % of its particles at any step.
 TEST_F(MeshBoundary, NoFluidParticleEntersASteppedBlockWithSharpEdges) {
