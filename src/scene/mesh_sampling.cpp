@@ -102,6 +102,13 @@ void sample(const std::vector<Vec3d>& x, const io::TriangleMesh& mesh, const std
 
 }  // namespace
 
+bool mesh_indices_valid(const io::TriangleMesh& mesh) {
+  const std::size_t n = mesh.vertices.size();
+  return std::all_of(mesh.triangles.begin(), mesh.triangles.end(), [&](const std::array<std::uint32_t, 3>& t) {
+    return t[0] < n && t[1] < n && t[2] < n && t[0] != t[1] && t[1] != t[2] && t[0] != t[2];
+  });
+}
+
 std::vector<Vec3d> placed_vertices(const ObstacleSource& o) {
   if (!o.mesh) return {};
   std::vector<Vec3d> out = o.mesh->vertices;
@@ -135,7 +142,7 @@ std::vector<Vec3d> placed_vertices(const ObstacleSource& o) {
 }
 
 std::uint64_t mesh_point_count(const ObstacleSource& o) {
-  if (!o.mesh || !(o.spacing > 0)) return 0;
+  if (!o.mesh || !(o.spacing > 0) || !mesh_indices_valid(*o.mesh)) return 0;
   const std::vector<Vec3d> x = placed_vertices(o);
   const std::vector<Edge> edges = unique_edges(*o.mesh);
   const double bound = count_bound(x, *o.mesh, edges, o.spacing);

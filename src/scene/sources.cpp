@@ -321,6 +321,11 @@ void check_buildable(const Scene& scene, std::uint64_t count) {
                  (!list->velocities.empty() && list->velocities.size() != list->positions.size())))
       throw SceneError(fmt::format("{}: particles[{}]: masses and velocities must have one entry per position",
                                    scene.file, k));
+    const auto* mesh = std::get_if<ObstacleSource>(&scene.sources[k]);
+    if (mesh && mesh->shape == ObstacleSource::Shape::Mesh && (!mesh->mesh || !mesh_indices_valid(*mesh->mesh)))
+      throw SceneError(fmt::format("{}: particles[{}].file: {} has not been read, or its triangles name vertices it "
+                                   "does not have (load_scene reads it)",
+                                   scene.file, k, mesh->file));
     const auto* snapshot = std::get_if<SnapshotSource>(&scene.sources[k]);
     if (snapshot && (!snapshot->content || snapshot->content->velocities.size() != snapshot->content->positions.size() ||
                      snapshot->content->masses.size() != snapshot->content->positions.size()))

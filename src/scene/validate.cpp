@@ -327,6 +327,8 @@ class Checker {
       fail(file_key, fmt::format("{} has not been read (load_scene reads it; a Scene built in code must fill "
                                  "ObstacleSource::mesh with at least one triangle)",
                                  o.file));
+    if (!mesh_indices_valid(*o.mesh))
+      fail(file_key, fmt::format("{}: a triangle names a vertex the mesh does not have, or one vertex twice", o.file));
     const std::vector<Vec3d> x = placed_vertices(o);
     Vec3d lo = x.front(), hi = x.front();
     for (std::size_t i = 0; i < x.size(); ++i) {

@@ -26,6 +26,7 @@
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/load.hpp"
 #include "swirl/scene/mesh_sampling.hpp"
+#include "swirl/scene/validate.hpp"
 
 namespace swirl::scene {
 namespace {
@@ -279,6 +280,22 @@ TEST(MeshObstacle, BadMeshesAreRefusedNamingTheSceneFileTheKeyAndTheReason) {
          "particles[1].spacing: " + (dir / "cube.stl").string() + ": the mesh's 12 triangles spanning");
   expect("file = \"cube.stl\"\ntranslate = [0.5, 0.5, 0.5]\nspacing = 0.0004", "more than the limit of 16777216 (2^24)");
   expect("file = \"cube.stl\"\ntranslate = [0.5, 0.5, 0.5]\nspacing = 0.00005", "up to about ");
+}
+
+TEST(MeshObstacle, AMeshBuiltInCodeWithBadIndicesIsRefusedBeforeItIsSampled) {
+  TempDir dir;
+  io::test::spit(dir / "cube.stl", test::ascii_stl(test::unit_cube()));
+  Scene s = load_with(dir, "file = \"cube.stl\"\ntranslate = [0.5, 0.5, 0.5]");
+  auto& o = std::get<ObstacleSource>(s.sources[1]);
+  auto bad = std::make_shared<io::TriangleMesh>(*o.mesh);
+  bad->triangles.push_back({0, 1, 8});  // the cube has vertices 0 to 7
+  o.mesh = bad;
+  EXPECT_EQ(mesh_point_count(o), 0u);
+  EXPECT_THROW(validate(s), SceneError);
+  EXPECT_THROW((void)make_particles<double>(s), SceneError);
+  o.mesh.reset();
+  EXPECT_THROW(validate(s), SceneError);
+  EXPECT_THROW((void)make_particles<double>(s), SceneError);
 }
 
 }  // namespace

@@ -34,6 +34,10 @@ namespace swirl::scene {
 // of 16.8 million s², 4000 × 4000 spacings).
 inline constexpr std::uint64_t kMaxMeshParticles = std::uint64_t{1} << 24;
 
+// True when every triangle names three different vertices the mesh has (as
+// io::read_triangle_mesh() makes them; a mesh built in code may not).
+bool mesh_indices_valid(const io::TriangleMesh& mesh);
+
 // The mesh's vertices where the scene places them: R·(scale·x) + translate,
 // R the rotation by rotate_deg about x, then y, then z. Empty without a mesh.
 std::vector<Vec3d> placed_vertices(const ObstacleSource& mesh);
@@ -41,7 +45,7 @@ std::vector<Vec3d> placed_vertices(const ObstacleSource& mesh);
 // The number of points mesh_points() makes at the source's spacing, exact; or,
 // when a cheap upper bound (about twice the count) exceeds 16·kMaxMeshParticles, that bound
 // (saturating at UINT64_MAX; then > kMaxMeshParticles either way). 0 without
-// a mesh or a spacing.
+// a mesh, with invalid indices, or without a spacing.
 std::uint64_t mesh_point_count(const ObstacleSource& mesh);
 
 // The points, in the scheme's order; empty when there would be more than
