@@ -6,6 +6,7 @@
 #include <map>
 #include <tuple>
 
+#include <assimp/IOSystem.hpp>
 #include <assimp/Importer.hpp>
 #include <assimp/MemoryIOWrapper.h>  // AI_MEMORYIO_MAGIC_FILENAME
 #include <assimp/postprocess.h>
@@ -14,6 +15,17 @@
 
 namespace swirl::io {
 namespace {
+
+// The file system Assimp sees beside the file handed to it from memory: empty.
+// (Its default would open what the file names, an OBJ's material library,
+// relative to the working directory.)
+class NoFiles final : public Assimp::IOSystem {
+ public:
+  bool Exists(const char*) const override { return false; }
+  char getOsSeparator() const override { return '/'; }
+  Assimp::IOStream* Open(const char*, const char*) override { return nullptr; }
+  void Close(Assimp::IOStream*) override {}
+};
 
 std::string lower(std::string text) {
   std::transform(text.begin(), text.end(), text.begin(), [](unsigned char c) { return char(std::tolower(c)); });
@@ -33,6 +45,7 @@ TriangleMesh read_triangle_mesh(const std::filesystem::path& path) {
   if (bytes.empty()) throw IoError(fmt::format("{}: the file is empty", name));
 
   Assimp::Importer importer;
+  importer.SetIOHandler(new NoFiles);  // owned by the importer
   // Only the triangulation of polygons: no smoothing, no merging of Assimp's
   // own (which compares normals too, and so would not merge an STL's corners).
   const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), aiProcess_Triangulate,

@@ -93,6 +93,10 @@ TEST(MeshObstacle, StlAsciiStlBinaryAndObjGiveTheSameParticles) {
   ASSERT_FALSE(ascii.empty());
   EXPECT_EQ(ascii, binary);
   EXPECT_EQ(ascii, wavefront);
+  // An OBJ naming a material library: not opened (Assimp sees no file system), the same particles.
+  io::test::spit(dir / "cube.mtl", "newmtl red\nKd 1 0 0\n");
+  io::test::spit(dir / "cube_mtl.obj", "mtllib cube.mtl\nusemtl red\n" + test::obj(cube));
+  EXPECT_EQ(sampled(load_with(dir, "file = \"cube_mtl.obj\"\ntranslate = [0.5, 0.5, 0.2]")), ascii);
   // The reader merged the corners: 8 vertices, 12 triangles, each corner once.
   const io::TriangleMesh m = io::read_triangle_mesh(dir / "cube_ascii.stl");
   EXPECT_EQ(m.vertices.size(), 8u);

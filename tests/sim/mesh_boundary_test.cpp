@@ -51,7 +51,7 @@ std::string dam_break(const fs::path& mesh, std::string_view method, double dt) 
 precision = "double"
 dt = "adaptive"
 dt_max = {dt}
-end_time = 0.6
+end_time = 0.45
 block_size = 64
 [box]
 min = [0.0, 0.0, 0.0]
@@ -109,7 +109,7 @@ TEST_F(MeshBoundary, NoFluidParticleEntersASteppedBlockWithSharpEdges) {
     double closest = 1, furthest_left = 1;
     std::size_t most_inside = 0;
     int steps = 0;
-    while (sim.time() < 0.6) {
+    while (sim.time() < 0.45) {
       sim.step();
       ++steps;
       const ParticleSet<double>& p = sim.particles();
