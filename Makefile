@@ -18,12 +18,13 @@ DEMO_OUT ?= out/demo
 
 # Debian 12 packages: what building the swirl tool needs (all `make demo`
 # installs; FreeType, libpng and the font are for `swirl render`, which is part
-# of the tool, HDF5 for its snapshots, Boost.Beast for swirl view's server), and what only the tests, micro-benchmarks
+# of the tool, HDF5 for its snapshots, Assimp for the mesh obstacles' STL and OBJ files, Boost.Beast for swirl view's
+# server), and what only the tests, micro-benchmarks
 # and bench plots need (python3-h5py: an independent HDF5 writer for the tests).
 DEB_BUILD_PACKAGES := cmake ninja-build g++ make git pkg-config \
                       libtomlplusplus-dev libcli11-dev libfmt-dev \
                       libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core libhdf5-dev \
-                      libboost-dev libboost-system-dev ccache
+                      libassimp-dev libboost-dev libboost-system-dev ccache
 # OpenMPI for distributed runs (make mpi; the tests run under mpirun). Not the demo's.
 DEB_MPI_PACKAGES   := libopenmpi-dev openmpi-bin
 # python3-venv, python3-dev and python3-numpy: the Python module's venv (make python).

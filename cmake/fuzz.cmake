@@ -88,9 +88,10 @@ function(swirl_fuzz_module module out_target)
                                     PROPERTIES COMPILE_OPTIONS -O0)
       endif()
     endforeach()
-    if(module STREQUAL "io")  # the HDF5 snapshots
+    if(module STREQUAL "io")  # the HDF5 snapshots, the mesh files
       include(${SWIRL_ROOT}/cmake/hdf5.cmake)
-      target_link_libraries(${target} PUBLIC PkgConfig::HDF5)
+      include(${SWIRL_ROOT}/cmake/assimp.cmake)
+      target_link_libraries(${target} PUBLIC PkgConfig::HDF5 assimp::assimp)
     endif()
   endif()
   set(${out_target} ${target} PARENT_SCOPE)

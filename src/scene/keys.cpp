@@ -882,6 +882,23 @@ std::vector<SourceKey> obstacle_keys(ObstacleSource::Shape shape) {
       k.push_back(field(SourceKey{.key = "normal", .doc = "its normal (any length > 0); the plane is clipped to the box"},
                         in_source(&ObstacleSource::normal)));
       break;
+    case Shape::Mesh:
+      k.push_back(field(SourceKey{.key = "file",
+                                  .doc = "an STL (ASCII or binary) or OBJ file of triangles, relative to the scene "
+                                         "file's folder; saved with a run as the absolute path it resolved to",
+                                  .required = true, .type_doc = "string (a path)"},
+                        in_source(&ObstacleSource::file)));
+      k.push_back(field(SourceKey{.key = "scale", .range = kPositive,
+                                  .doc = "multiplies the file's coordinates (0.001: a file in mm)"},
+                        in_source(&ObstacleSource::scale)));
+      k.push_back(field(SourceKey{.key = "rotate_deg", .unit = "degrees",
+                                  .doc = "turns the scaled mesh about the x, then the y, then the z axis (right-handed, "
+                                         "about the origin)"},
+                        in_source(&ObstacleSource::rotate_deg)));
+      k.push_back(field(SourceKey{.key = "translate", .unit = "m",
+                                  .doc = "then moves it; the placed mesh lies inside the box"},
+                        in_source(&ObstacleSource::translate)));
+      break;
   }
   k.push_back(field(SourceKey{.key = "spacing", .unit = "m", .range = kPositive,
                               .doc = "the distance between its boundary particles",
@@ -930,7 +947,9 @@ std::vector<SourceKind> declare_source_kinds() {
         "a static sphere: its surface sampled by boundary particles (needs `[sph]`, grid search)",
         "a static closed cylinder: side and end discs sampled by boundary particles (needs `[sph]`, grid search)",
         "a static plane clipped to the box (a wall across it), sampled by boundary particles (needs `[sph]`, grid "
-        "search)"};
+        "search)",
+        "a static triangle mesh from an STL or OBJ file: its vertices, edges and faces sampled by boundary particles "
+        "at most a spacing apart (docs/sph.md; needs `[sph]`, grid search)"};
     kinds.push_back({shape.name, docs[static_cast<std::size_t>(shape.value)], obstacle_keys(shape.value), prototype});
   }
   // Each key's docs table is its kind.

@@ -22,6 +22,7 @@
 #include "messages.hpp"
 #include "sources.hpp"
 #include "swirl/io/read_file.hpp"
+#include "swirl/io/mesh_file.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/scene/keys.hpp"
 #include "swirl/scene/validate.hpp"
@@ -552,6 +553,29 @@ void read_snapshot_file(const Table& t, SnapshotSource& src) {
   }
 }
 
+// An obstacle_mesh's file: its path resolved as a snapshot's is (against the
+// scene file's folder, once, to an absolute path that parse_scene writes back
+// into the scene's TOML) and its triangles read now, so that a missing or
+// broken file is refused when the scene is loaded, and validation counts the
+// particles that will be built. A resume reads it again.
+void read_mesh_file(const Table& t, ObstacleSource& src) {
+  namespace fs = std::filesystem;
+  const fs::path base = fs::path(std::string(t.reader().file())).parent_path();
+  std::error_code ec;
+  const fs::path path = fs::absolute(base / fs::path(src.file), ec).lexically_normal();
+  if (ec) t.fail("file", fmt::format("'{}' cannot be made absolute: {}", src.file, ec.message()));
+  src.file = path.string();
+  if (!fs::exists(path, ec))
+    t.fail("file", fmt::format("{}: no such file (the scene reads it whenever it is loaded, `swirl run --resume` "
+                               "included: put the file back at this path)",
+                               src.file));
+  try {
+    src.mesh = std::make_shared<const io::TriangleMesh>(io::read_triangle_mesh(path));
+  } catch (const io::IoError& e) {
+    t.fail("file", e.what());  // names the file and the reason
+  }
+}
+
 // Boundary particles are sampled at the fluid's spacing unless told: the
 // walls (box.walls = "particles") and every obstacle without a `spacing` take
 // the first fluid_block's.
@@ -614,6 +638,7 @@ void read_particles(const Table& top, Scene& s) {
       if (const auto* given = t.find("spacing"))
         obstacle->spacing = r.number(*given, t.key("spacing"), spec_in<ParticleSource>(kind.keys, "spacing").range);
       obstacle->clip = s.box;
+      if (obstacle->shape == ObstacleSource::Shape::Mesh) read_mesh_file(t, *obstacle);
     }
     s.sources.push_back(std::move(source));
   }
@@ -804,12 +829,17 @@ Scene parse_scene(std::string_view text, std::string_view file, std::span<const 
   const Reader r(file);
   for (const auto& o : overrides) apply_override(root, o, r);
   Scene scene = read_scene(root, file);
-  // Each snapshot source's file as resolved (absolute), so that the TOML saved
-  // with a run names it from any working directory (read_snapshot_file).
+  // Each snapshot's and mesh's file as resolved (absolute), so that the TOML
+  // saved with a run names it from any working directory (read_snapshot_file).
   if (auto* list = root["particles"].as_array(); list && !scene.random_box)
-    for (std::size_t i = 0; i < scene.sources.size() && i < list->size(); ++i)
+    for (std::size_t i = 0; i < scene.sources.size() && i < list->size(); ++i) {
+      auto* table = (*list)[i].as_table();
+      if (!table) continue;
       if (const auto* snapshot = std::get_if<SnapshotSource>(&scene.sources[i]))
-        if (auto* table = (*list)[i].as_table()) table->insert_or_assign("file", snapshot->file);
+        table->insert_or_assign("file", snapshot->file);
+      const auto* mesh = std::get_if<ObstacleSource>(&scene.sources[i]);
+      if (mesh && mesh->shape == ObstacleSource::Shape::Mesh) table->insert_or_assign("file", mesh->file);
+    }
   std::ostringstream effective;
   effective << root;
   scene.toml = effective.str();

@@ -11,6 +11,7 @@
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/core/random.hpp"
 #include "swirl/scene/initial_conditions.hpp"
+#include "swirl/scene/mesh_sampling.hpp"
 #include "swirl/sph/lattice_mass.hpp"
 
 namespace swirl::scene {
@@ -112,6 +113,7 @@ std::uint64_t obstacle_count(const ObstacleSource& s) {
       if (!(reach < 0x1p15)) return kSaturated;
       return obstacle_points(s).size();
     }
+    case Shape::Mesh: return mesh_point_count(s);
   }
   return 0;
 }
@@ -319,6 +321,11 @@ void check_buildable(const Scene& scene, std::uint64_t count) {
                  (!list->velocities.empty() && list->velocities.size() != list->positions.size())))
       throw SceneError(fmt::format("{}: particles[{}]: masses and velocities must have one entry per position",
                                    scene.file, k));
+    const auto* mesh = std::get_if<ObstacleSource>(&scene.sources[k]);
+    if (mesh && mesh->shape == ObstacleSource::Shape::Mesh && (!mesh->mesh || !mesh_indices_valid(*mesh->mesh)))
+      throw SceneError(fmt::format("{}: particles[{}].file: {} has not been read, or its triangles name vertices it "
+                                   "does not have (load_scene reads it)",
+                                   scene.file, k, mesh->file));
     const auto* snapshot = std::get_if<SnapshotSource>(&scene.sources[k]);
     if (snapshot && (!snapshot->content || snapshot->content->velocities.size() != snapshot->content->positions.size() ||
                      snapshot->content->masses.size() != snapshot->content->positions.size()))
@@ -384,6 +391,7 @@ std::vector<Vec3d> obstacle_points(const ObstacleSource& s) {
   const double spacing = s.spacing;
   std::vector<Vec3d> out;
   if (!(spacing > 0)) return out;
+  if (s.shape == Shape::Mesh) return mesh_points(s);  // bounded by kMaxMeshParticles
   if (s.shape != Shape::Plane && detail::obstacle_count(s) > detail::kMaxParticles) return out;
   switch (s.shape) {
     case Shape::Box: return box_surface(s.region, spacing);
@@ -429,6 +437,7 @@ std::vector<Vec3d> obstacle_points(const ObstacleSource& s) {
         }
       return out;
     }
+    case Shape::Mesh: break;  // above
   }
   return out;
 }

@@ -12,6 +12,7 @@
 #include "sources.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/keys.hpp"
+#include "swirl/scene/mesh_sampling.hpp"
 
 namespace swirl::scene {
 namespace {
@@ -369,9 +370,44 @@ class Checker {
         inside(o.point, key("point"));
         if (!(norm(o.normal) > 0)) fail(key("normal"), "must not be zero");
         break;
+      case Shape::Mesh: mesh(o, where); return;
     }
     if (detail::obstacle_count(o) == 0)
       fail(where, fmt::format("makes no boundary particles at spacing {}", o.spacing));
+  }
+
+  // A mesh obstacle: read, placed at finite coordinates inside the box, and
+  // not more boundary particles than kMaxMeshParticles.
+  void mesh(const ObstacleSource& o, std::string_view where) const {
+    const std::string file_key = fmt::format("{}.file", where);
+    if (!o.mesh || o.mesh->triangles.empty())
+      fail(file_key, fmt::format("{} has not been read (load_scene reads it; a Scene built in code must fill "
+                                 "ObstacleSource::mesh with at least one triangle)",
+                                 o.file));
+    if (!mesh_indices_valid(*o.mesh))
+      fail(file_key, fmt::format("{}: a triangle names a vertex the mesh does not have, or one vertex twice", o.file));
+    const std::vector<Vec3d> x = placed_vertices(o);
+    Vec3d lo = x.front(), hi = x.front();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      if (!std::isfinite(x[i].x) || !std::isfinite(x[i].y) || !std::isfinite(x[i].z))
+        fail(fmt::format("{}.scale", where), fmt::format("{}: vertex {} lands at {}: scale, rotate_deg and translate "
+                                                         "must keep the mesh finite",
+                                                         o.file, i, detail::vec_text(x[i])));
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], x[i][a]), hi[a] = std::max(hi[a], x[i][a]);
+    }
+    if (s_.walls && (!s_.box.contains(lo) || !s_.box.contains(hi)))
+      fail(fmt::format("{}.translate", where),
+           fmt::format("{}: the placed mesh reaches outside the box {} (it spans {} to {}); move it with translate, "
+                       "or shrink it with scale",
+                       o.file, detail::box_text(s_.box), detail::vec_text(lo), detail::vec_text(hi)));
+    const std::uint64_t n = mesh_point_count(o);
+    if (n > kMaxMeshParticles)
+      fail(fmt::format("{}.spacing", where),
+           fmt::format("{}: the mesh's {} triangles spanning {} to {} would make {} boundary particles at spacing {}, "
+                       "more than the limit of {} (2^24) per mesh; use a larger spacing or a smaller mesh",
+                       o.file, o.mesh->triangles.size(), detail::vec_text(lo), detail::vec_text(hi),
+                       fmt::format("{}{}", n > 16 * kMaxMeshParticles ? "up to about " : "", count_text(n)),
+                       o.spacing, kMaxMeshParticles));
   }
 
   void stellar(const StellarSource& m, std::string_view where) const {

@@ -27,6 +27,7 @@
 #include "swirl/gravity/initial_conditions.hpp"
 #include "swirl/gravity/settings.hpp"
 #include "swirl/gravity/spherical_models.hpp"
+#include "swirl/io/mesh_file.hpp"
 #include "swirl/sph/parameters.hpp"
 
 namespace swirl::scene {
@@ -149,16 +150,19 @@ struct SnapshotSource {
 // A static obstacle, sampled by one layer of boundary particles (Akinci et
 // al. 2012; core/particle_kind.hpp) at `spacing` (default: the first
 // fluid_block's): the surface of a box (a box of zero extent along one axis
-// is a thin plate), of a sphere, of a closed cylinder (side and end discs), or
-// a plane clipped to the scene's box. Needs [sph] with the grid search.
+// is a thin plate), of a sphere, of a closed cylinder (side and end discs), a
+// plane clipped to the scene's box, or the triangles of an STL or OBJ file.
+// Needs [sph] with the grid search.
 // Sampling (scene/initial_conditions.hpp, obstacle_points()): a box's surface
 // is the lattice points of [min, max] with n_a = round(extent_a / spacing)
 // intervals per axis that lie on a face; a sphere's is a Fibonacci lattice of
 // round(4πr²/spacing²) points; a cylinder's is round(L/spacing) + 1 rings of
 // round(2πr/spacing) points along the axis and concentric rings on the end
-// discs; a plane's is a square lattice through `point` inside the box.
+// discs; a plane's is a square lattice through `point` inside the box; a
+// mesh's is its vertices, its edges and its triangles' insides at most a
+// spacing apart (mesh_points(), scene/mesh_sampling.hpp).
 struct ObstacleSource {
-  enum class Shape { Box, Sphere, Cylinder, Plane };
+  enum class Shape { Box, Sphere, Cylinder, Plane, Mesh };
   Shape shape = Shape::Box;
   Box<double> region;       // box: min, max (m)
   Vec3d center{};           // sphere: its centre (m)
@@ -168,6 +172,18 @@ struct ObstacleSource {
   Vec3d normal{0, 0, 1};    // plane: its normal (any length > 0)
   double spacing = 0;       // m, > 0 once loaded (load_scene: the first fluid_block's when not given)
   Box<double> clip;         // plane: the box it is clipped to (load_scene: the scene's box)
+  // mesh: the file (an absolute, lexically normal path once loaded, as a
+  // snapshot's), and how its vertices are placed: x' = R·(scale·x) + translate,
+  // R the rotation about x, then y, then z by rotate_deg's three angles.
+  std::string file;
+  double scale = 1;
+  Vec3d rotate_deg{};
+  Vec3d translate{};
+  // mesh: the triangles as the file gives them (before scale, rotation and
+  // translation). Filled by load_scene, which reads the file; shared by copies
+  // of the Scene. A Scene built in code must fill it too (validate() refuses a
+  // mesh without it).
+  std::shared_ptr<const io::TriangleMesh> mesh;
   // Its name in probes.csv (output.obstacle_forces); empty: "obstacle<k>", k
   // counting the scene's obstacles from 1 in source order.
   std::string name;
@@ -175,13 +191,14 @@ struct ObstacleSource {
 
 // The point about which an obstacle's torque is taken (probes.csv): the
 // centre of its box, its sphere's centre, the middle of its cylinder's axis,
-// its plane's point.
+// its plane's point, a mesh's origin as placed (translate).
 inline Vec3d obstacle_centre(const ObstacleSource& o) {
   switch (o.shape) {
     case ObstacleSource::Shape::Box: return (o.region.lo + o.region.hi) * 0.5;
     case ObstacleSource::Shape::Sphere: return o.center;
     case ObstacleSource::Shape::Cylinder: return (o.start + o.end) * 0.5;
     case ObstacleSource::Shape::Plane: return o.point;
+    case ObstacleSource::Shape::Mesh: return o.translate;
   }
   return o.point;
 }
@@ -196,11 +213,12 @@ struct Probe {
 };
 
 // The obstacle shapes' names, which are also their [[particles]] kinds.
-inline constexpr std::array<EnumName<ObstacleSource::Shape>, 4> kObstacleShapeNames{{
+inline constexpr std::array<EnumName<ObstacleSource::Shape>, 5> kObstacleShapeNames{{
     {"obstacle_box", ObstacleSource::Shape::Box},
     {"obstacle_sphere", ObstacleSource::Shape::Sphere},
     {"obstacle_cylinder", ObstacleSource::Shape::Cylinder},
     {"obstacle_plane", ObstacleSource::Shape::Plane},
+    {"obstacle_mesh", ObstacleSource::Shape::Mesh},
 }};
 
 using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource, SnapshotSource, ObstacleSource>;
