@@ -806,7 +806,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
 
 // What of a scene (built: its particles) does not run on several ranks yet.
 template <class Real>
-std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<Real>& particles) {
+std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<Real>& /*particles*/) {
   if (scene.nbody) {
     if (scene.time_steps == scene::TimeSteps::Block) return "simulation.time_steps = \"block\"";
     const std::string no = gravity::GravityForce<Real>(*scene.nbody).distributed_support();
@@ -816,9 +816,7 @@ std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<
     const std::string no = sph::SphFluid<Real>(*scene.sph).distributed_support();
     if (!no.empty()) return no;
   }
-  if (particles.find_int_field(kKindField) != ParticleSet<Real>::npos)
-    return "boundary particles (box.walls = \"particles\", obstacles)";
-  return {};
+  return {};  // boundary particles (box.walls = "particles", obstacles) run on ranks too
 }
 
 // Memory and disk a scene needs, estimated before anything is allocated.
