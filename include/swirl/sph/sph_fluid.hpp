@@ -402,7 +402,7 @@ class SphFluid final : public Solver<Real> {
            lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
            hash_.offsets().capacity() * sizeof(std::uint32_t) + hash_.order().capacity() * sizeof(std::uint32_t) +
-           hash_.neighbour_hashes().capacity() * sizeof(std::uint32_t);
+           hash_.neighbour_hashes().capacity() * sizeof(std::uint32_t) + local_bytes();
   }
 
  private:
@@ -693,6 +693,14 @@ class SphFluid final : public Solver<Real> {
     count_evaluation();
   }
 
+  // DFSPH on ranks: the local set, its keys and a pass's output.
+  std::size_t local_bytes() const {
+    std::size_t reals = local_out_.capacity(), ints = 0;
+    local_.for_each_array([&](const AlignedVector<Real>& a) { reals += a.capacity(); });
+    local_.for_each_int_array([&](const auto& a) { ints += a.capacity(); });
+    return reals * sizeof(Real) + ints * sizeof(std::int32_t) + local_.id.capacity() * sizeof(local_.id[0]) +
+           halo_keys_.capacity() * sizeof(std::uint64_t);
+  }
   // What exchange 1 sends: kHaloFields, and the particles' kinds when they have them.
   static std::vector<std::string> exchange_fields(const ParticleSet<Real>& p) {
     std::vector<std::string> fields = kHaloFields;
