@@ -795,7 +795,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
 
 // What of a scene (built: its particles) does not run on several ranks yet.
 template <class Real>
-std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<Real>& particles) {
+std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<Real>& /*particles*/) {
   if (scene.nbody) {
     if (scene.time_steps == scene::TimeSteps::Block) return "simulation.time_steps = \"block\"";
     const std::string no = gravity::GravityForce<Real>(*scene.nbody).distributed_support();
@@ -805,8 +805,7 @@ std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<
     const std::string no = sph::SphFluid<Real>(*scene.sph).distributed_support();
     if (!no.empty()) return no;
   }
-  if (particles.find_int_field(kKindField) != ParticleSet<Real>::npos)
-    return "boundary particles (box.walls = \"particles\", obstacles)";
+  // Boundary particles (box.walls = "particles", obstacles) run on ranks too.
   // probes.csv samples the whole set on one rank; on ranks it would need the
   // gathered state every probe row (docs/sph.md, Probes).
   if (scene.has_probe_output()) return "probes ([[probes]], output.obstacle_forces)";

@@ -32,6 +32,10 @@
 // for). A boundary particle itself is skipped: ρ_b = ρ0, α_b = 0, Dρ/Dt = 0,
 // its velocity and acceleration untouched.
 //
+// `only` (every pass): computes the particles [only.begin, only.end) alone,
+// reading the others as neighbours (a rank's own particles among its ghosts,
+// dist/halo.hpp); each particle's result is the bits of a pass over all.
+//
 // Scalar loops, one pair at a time (correctness first: the SIMD twins of the
 // thesis's passes, sph/grid_passes.hpp, are the model for faster ones).
 // Each pass writes only particle i's entries and gathers over the grid's fixed
@@ -44,6 +48,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "swirl/core/index_range.hpp"
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/parallel/for_blocks.hpp"
@@ -68,6 +73,14 @@ inline void for_each_pair(const Real* x, const Real* y, const Real* z, std::size
       if (!spatial::within(r2, h2)) continue;
       pair(j, dx, dy, dz, r2);
     }
+}
+
+// The particles a pass computes: `only`, or all of them when only is kAllParticles.
+inline constexpr IndexRange kAllParticles{0, ~std::uint32_t{0}};
+inline IndexRange pass_range(IndexRange only, std::size_t n) {
+  if (only.begin == kAllParticles.begin && only.end == kAllParticles.end) return {0, static_cast<std::uint32_t>(n)};
+  check_range(only, n);
+  return only;
 }
 
 }  // namespace detail
@@ -95,16 +108,18 @@ double dfsph_lattice_factor(const DfsphKernel<Real>& kernel, double m, double s)
 template <class Real>
 std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
                                        const DfsphKernel<Real>& kernel, std::size_t block_size, Real* alpha,
-                                       Real alpha_cap, const std::int32_t* kind = nullptr, Real rest_density = 0) {
-  const std::size_t n = p.size();
+                                       Real alpha_cap, const std::int32_t* kind = nullptr, Real rest_density = 0,
+                                       IndexRange only = detail::kAllParticles) {
+  const IndexRange range = detail::pass_range(only, p.size());
+  const std::size_t from = range.begin;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real* rho = p.density.data();
   return parallel::reduce_blocks_pinned(
-      "dfsph_density", n, block_size, std::uint64_t{0},
+      "dfsph_density", range.end - range.begin, block_size, std::uint64_t{0},
       [&](std::size_t b, std::size_t e) {
         const DfsphKernel<Real> k = kernel;
         std::uint64_t pairs = 0;
-        detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+        detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
           if (kind && is_boundary(kind[i])) {
             rho[i] = rest_density;
             alpha[i] = 0;
@@ -138,12 +153,15 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
 template <class Real>
 void dfsph_density_change(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& p,
                           const DfsphKernel<Real>& kernel, std::size_t block_size, Real* out,
-                          const std::int32_t* kind = nullptr) {
+                          const std::int32_t* kind = nullptr, IndexRange only = detail::kAllParticles) {
+  const IndexRange range = detail::pass_range(only, p.size());
+  const std::size_t from = range.begin;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
-  parallel::for_blocks_pinned("dfsph_density_change", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+  parallel::for_blocks_pinned("dfsph_density_change", range.end - range.begin, block_size,
+                              [&](std::size_t b, std::size_t e, std::size_t) {
     const DfsphKernel<Real> k = kernel;
-    detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
       if (kind && is_boundary(kind[i])) {
         out[i] = 0;
         return;
@@ -164,12 +182,15 @@ void dfsph_density_change(const spatial::SortedCellGrid<Real>& grid, const Parti
 template <class Real>
 void dfsph_pressure_velocity(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
                              const DfsphKernel<Real>& kernel, std::size_t block_size, const Real* k_over_rho, Real dt,
-                             const std::int32_t* kind = nullptr) {
+                             const std::int32_t* kind = nullptr, IndexRange only = detail::kAllParticles) {
+  const IndexRange range = detail::pass_range(only, p.size());
+  const std::size_t from = range.begin;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
-  parallel::for_blocks_pinned("dfsph_pressure", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+  parallel::for_blocks_pinned("dfsph_pressure", range.end - range.begin, block_size,
+                              [&](std::size_t b, std::size_t e, std::size_t) {
     const DfsphKernel<Real> k = kernel;
-    detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
       if (kind && is_boundary(kind[i])) return;
       Real ax = 0, ay = 0, az = 0;
       const Real ki = k_over_rho[i];
@@ -187,13 +208,17 @@ void dfsph_pressure_velocity(const spatial::SortedCellGrid<Real>& grid, Particle
 // a_i += the thesis's viscous acceleration (eq. 2.10 / ρ_i, laws.viscosity).
 template <class Real>
 void dfsph_add_viscosity(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
-                         std::size_t block_size, const std::int32_t* kind = nullptr) {
+                         std::size_t block_size, const std::int32_t* kind = nullptr,
+                         IndexRange only = detail::kAllParticles) {
+  const IndexRange range = detail::pass_range(only, p.size());
+  const std::size_t from = range.begin;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data(), *rho = p.density.data();
   Real *ax = p.acceleration.x.data(), *ay = p.acceleration.y.data(), *az = p.acceleration.z.data();
-  parallel::for_blocks_pinned("dfsph_viscosity", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+  parallel::for_blocks_pinned("dfsph_viscosity", range.end - range.begin, block_size,
+                              [&](std::size_t b, std::size_t e, std::size_t) {
     const SphLaws<Real> law = laws;
-    detail::for_each_in_cells(grid, b, e, [&](std::size_t i, const auto& ranges, int count) {
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
       if (kind && is_boundary(kind[i])) return;  // static: its acceleration is zeroed anyway
       Real sx = 0, sy = 0, sz = 0;
       detail::for_each_pair(x, y, z, i, ranges, count, law.h2, [&](std::size_t j, Real, Real, Real, Real r2) {

@@ -54,12 +54,18 @@
 //
 // Resume: the warm starts are particle fields; the grid and α are not, so the
 // first step after a resume re-evaluates the forces at the restored x (the
-// same bits: the same positions in the same order) before step 1.
+// same bits: the same positions in the same order) before step 1, leaving the
+// fluid's evaluation tally (its state: the summary's mean neighbour count) as
+// the uninterrupted run has it, so the checkpoints that follow are its bytes.
 //
 // Determinism: every pass gathers into particle i over the grid's fixed order;
 // the errors that stop the solves are block-ordered sums (parallel::
 // reduce_blocks), so the iteration counts and every bit are the same for any
-// thread count.
+// thread count. On several ranks (SphFluid's passes run among ghosts, see
+// sph_fluid.hpp) the same sums are formed across the ranks in the one-rank
+// blocks of the global order (dist/block_sum.hpp: the raw values of a block
+// cut by a rank boundary travel), so every rank count gives the one-rank bits
+// too; the CFL limit is the simulation's global scan.
 #pragma once
 
 #include <algorithm>
@@ -112,7 +118,11 @@ class DfsphStepper final : public integrate::Stepper<Real> {
     const Real dt = Real(r.dt);
     const std::size_t bs = r.block_size;
     if (refresh_) {  // after a resume: the grid and α at the restored positions
+      // (the evaluation the uninterrupted run made at the end of the last step:
+      // not counted twice in the fluid's tally, which the checkpoint holds)
+      const auto tally = fluid_.tally();
       forces.evaluate(r.t_next - r.dt);
+      fluid_.set_tally(tally);
       fluid_.add_viscosity(p, bs);
       refresh_ = false;
     }
@@ -258,17 +268,27 @@ class DfsphStepper final : public integrate::Stepper<Real> {
     for (;;) {
       fluid_.density_change(p, d, bs);
       // Σ_i of the compression (ρ* − ρ0, or Dρ/Dt·Δt), positive parts only, in block order.
-      const double sum = parallel::reduce_blocks_pinned(
-          "dfsph_error", n, bs, 0.0,
-          [&](std::size_t b, std::size_t e) {
-            double t = 0;
-            for (std::size_t i = b; i < e; ++i) {
-              const Real excess = density ? rho[i] + dt * d[i] - rho0 : dt * d[i];
-              t += excess > Real(0) ? double(excess) : 0.0;
-            }
-            return t;
-          },
-          [](double a, double b) { return a + b; });
+      const auto compression = [&](std::size_t i) {
+        const Real excess = density ? rho[i] + dt * d[i] - rho0 : dt * d[i];
+        return excess > Real(0) ? double(excess) : 0.0;
+      };
+      double sum = 0;
+      if (fluid_.on_ranks()) {  // the one-rank block order across the ranks (the same bits)
+        errors_.resize(n);
+        parallel::for_blocks_pinned("dfsph_error", n, bs, [&](std::size_t b, std::size_t e, std::size_t) {
+          for (std::size_t i = b; i < e; ++i) errors_[i] = compression(i);
+        });
+        sum = fluid_.block_sum(errors_, bs);
+      } else {
+        sum = parallel::reduce_blocks_pinned(
+            "dfsph_error", n, bs, 0.0,
+            [&](std::size_t b, std::size_t e) {
+              double t = 0;
+              for (std::size_t i = b; i < e; ++i) t += compression(i);
+              return t;
+            },
+            [](double a, double b) { return a + b; });
+      }
       s.error = sum * scale;
       if ((s.iterations >= min_iterations && s.error <= tolerance) || s.iterations >= cap) break;
       const Real inv_dt2 = Real(1) / (dt * dt), inv_dt = Real(1) / dt;
@@ -368,6 +388,7 @@ class DfsphStepper final : public integrate::Stepper<Real> {
   SphFluid<Real>& fluid_;
   std::optional<boundary::BoxCollision<Real>> box_;
   AlignedVector<Real> change_, k_over_rho_;  // scratch: (Dρ/Dt)_i and Δκ_i/ρ_i
+  std::vector<double> errors_;               // scratch on ranks: each particle's compression
   DfsphSolve last_density_, last_divergence_;
   double steps_ = 0, density_iterations_ = 0, divergence_iterations_ = 0;
   double max_density_iterations_ = 0, max_divergence_iterations_ = 0, max_density_error_ = 0, max_divergence_error_ = 0;

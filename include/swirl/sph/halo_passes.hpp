@@ -47,15 +47,21 @@ inline const std::vector<std::string> kHaloFields{"position", "velocity", "mass"
 // What they read of it after (exchange 2).
 inline const std::vector<std::string> kHaloRefreshFields{"density", "pressure"};
 
-// Returns the own particles' neighbour pairs (self excluded).
-template <class Real>
+// Returns the own particles' neighbour pairs (self excluded). between(): run
+// after exchange 2, before the ghosts' volumes are derived (the boundary
+// particles' mirrored pressure, sph_fluid.hpp, which reads the ghosts' fluid
+// pressures and writes the own boundary particles' ρ, p, V and pV); when it
+// returns true, density and pressure are exchanged again, so that the ghosts'
+// entries are their owners' after it.
+template <class Real, class Between>
 std::uint64_t halo_density_and_forces(const dist::Communicator& comm, dist::Halo& halo,
                                       const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
                                       const SphLaws<Real>& laws, std::size_t block_size, GridScratch<Real>& scratch,
-                                      KernelPath path) {
+                                      KernelPath path, Between&& between) {
   const IndexRange own = halo.owned();
   const std::uint64_t pairs = grid_density(grid, p, laws, block_size, scratch, path, own);
   halo.refresh(comm, p, kHaloRefreshFields);
+  if (between()) halo.refresh(comm, p, kHaloRefreshFields);
   // The ghosts' volumes, with the density pass's arithmetic (one division, one product).
   const Real *m = p.mass.data(), *rho = p.density.data(), *pr = p.pressure.data();
   auto volumes = [&](std::size_t b, std::size_t e) {
@@ -69,6 +75,14 @@ std::uint64_t halo_density_and_forces(const dist::Communicator& comm, dist::Halo
   if (laws.corrected) grid_gradient_correction(grid, p, laws, block_size, scratch, own);
   grid_forces(grid, p, laws, block_size, scratch, path, own);
   return pairs;
+}
+
+template <class Real>
+std::uint64_t halo_density_and_forces(const dist::Communicator& comm, dist::Halo& halo,
+                                      const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
+                                      const SphLaws<Real>& laws, std::size_t block_size, GridScratch<Real>& scratch,
+                                      KernelPath path) {
+  return halo_density_and_forces(comm, halo, grid, p, laws, block_size, scratch, path, [] { return false; });
 }
 
 }  // namespace swirl::sph

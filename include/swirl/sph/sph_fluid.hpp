@@ -92,9 +92,18 @@
 //
 // On several ranks (a context with ranks: dist/rank_order.hpp) each rank
 // computes its own particles among ghosts from the others (dist/halo.hpp,
-// sph/halo_passes.hpp): the thesis's solver on the grid, without boundary
-// particles, gives every particle the one-rank bits. DFSPH, the hash search
-// and boundary particles are refused there for now (distributed_support()).
+// sph/halo_passes.hpp), and every particle gets the one-rank bits:
+//  - the thesis's solver: exchange 1 (position, velocity, mass, and the kind
+//    with boundary particles), the density pass, exchange 2 (ρ, p); with
+//    boundary particles ψ_b of the own ones at the first evaluation, then the
+//    ghosts' masses (exchange 2 of mass), and after the density pass the own
+//    p_b from the ghosts' fluid pressures, then ρ and p again so that the
+//    ghosts' p_b are their owners'; the forces;
+//  - DFSPH: the evaluation builds a local set (own particles among ghosts)
+//    that the stepper's passes use until the next evaluation; each pass first
+//    refreshes what it reads of the ghosts (velocities, κ/ρ), and the solves'
+//    errors are the one-rank block-order sums (block_sum, dist/block_sum.hpp).
+// The hash search is refused there (distributed_support()).
 //
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
 // Every pass gathers into particle i only: deterministic for any thread count.
@@ -104,6 +113,7 @@
 #include <array>
 #include <cmath>
 #include <optional>
+#include <span>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -118,6 +128,7 @@
 #include "swirl/force/solver.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/sph/dfsph_passes.hpp"
+#include "swirl/dist/block_sum.hpp"
 #include "swirl/dist/rank_order.hpp"
 #include "swirl/sph/grid_passes.hpp"
 #include "swirl/sph/halo_passes.hpp"
@@ -175,8 +186,12 @@ class SphFluid final : public Solver<Real> {
   }
 
   void add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) override {
+    ranks_ = ctx.ranks;
     if (ctx.ranks) {
-      add_acceleration_ranks(p, ctx);
+      if (dfsph())
+        dfsph_evaluate_ranks(p, ctx);
+      else
+        add_acceleration_ranks(p, ctx);
       return;
     }
     if (dfsph()) {
@@ -234,17 +249,58 @@ class SphFluid final : public Solver<Real> {
   // ---- DFSPH (sph/dfsph_stepper.hpp): passes on the last evaluation's grid ----
   // Valid between an evaluation and the next position change.
   const DfsphKernel<Real>& dfsph_kernel() const { return *kernel_; }
-  // α_i of the last evaluation (sorted order), for every particle.
-  const Real* factor() const { return alpha_.data(); }
-  void density_change(const ParticleSet<Real>& p, Real* out, std::size_t block_size) const {
-    dfsph_density_change(grid_, p, *kernel_, block_size, out, kinds(p));
+  // On several ranks (after an evaluation there) p holds this rank's own
+  // particles and each pass runs on the evaluation's local set (own particles
+  // among their ghosts, dfsph_evaluate_ranks): it copies in what the stepper
+  // changed since (velocities, κ/ρ, accelerations), refreshes the ghosts' copy
+  // of what the pass reads of them (exchange 2), and copies the own results back.
+  // α_i of the last evaluation (sorted order), for every particle of p.
+  const Real* factor() const { return alpha_.data() + (ranks_ ? own_.begin : 0); }
+  void density_change(const ParticleSet<Real>& p, Real* out, std::size_t block_size) {
+    if (!ranks_) {
+      dfsph_density_change(grid_, p, *kernel_, block_size, out, kinds(p));
+      return;
+    }
+    to_local(p.velocity, local_.velocity);
+    halo_.refresh(ranks_->comm(), local_, {"velocity"});
+    local_out_.resize(local_.size());
+    dfsph_density_change(grid_, local_, *kernel_, block_size, local_out_.data(), kinds(local_), own_);
+    std::copy_n(local_out_.data() + own_.begin, p.size(), out);
   }
-  void pressure_velocity(ParticleSet<Real>& p, const Real* k_over_rho, Real dt, std::size_t block_size) const {
-    dfsph_pressure_velocity(grid_, p, *kernel_, block_size, k_over_rho, dt, kinds(p));
+  void pressure_velocity(ParticleSet<Real>& p, const Real* k_over_rho, Real dt, std::size_t block_size) {
+    if (!ranks_) {
+      dfsph_pressure_velocity(grid_, p, *kernel_, block_size, k_over_rho, dt, kinds(p));
+      return;
+    }
+    AlignedVector<Real>& kr = local_.extra(kr_field_);
+    std::copy_n(k_over_rho, p.size(), kr.data() + own_.begin);
+    halo_.refresh(ranks_->comm(), local_, {std::string(kLocalKappaField)});
+    to_local(p.velocity, local_.velocity);
+    dfsph_pressure_velocity(grid_, local_, *kernel_, block_size, kr.data(), dt, kinds(local_), own_);
+    from_local(local_.velocity, p.velocity);
   }
   // The non-pressure force of the fluid: the thesis's viscosity (eq. 2.10).
-  void add_viscosity(ParticleSet<Real>& p, std::size_t block_size) const {
-    if (params_.viscosity > 0) dfsph_add_viscosity(grid_, p, SphLaws<Real>(params_), block_size, kinds(p));
+  void add_viscosity(ParticleSet<Real>& p, std::size_t block_size) {
+    if (!(params_.viscosity > 0)) return;
+    if (!ranks_) {
+      dfsph_add_viscosity(grid_, p, SphLaws<Real>(params_), block_size, kinds(p));
+      return;
+    }
+    to_local(p.velocity, local_.velocity);
+    halo_.refresh(ranks_->comm(), local_, {"velocity"});
+    to_local(p.acceleration, local_.acceleration);
+    dfsph_add_viscosity(grid_, local_, SphLaws<Real>(params_), block_size, kinds(local_), own_);
+    from_local(local_.acceleration, p.acceleration);
+  }
+  // True when the last evaluation ran on several ranks.
+  bool on_ranks() const { return ranks_ != nullptr; }
+  // Σ of one value per particle of p, in the one-rank run's block order
+  // (parallel::reduce_blocks with block_size, summing from 0): on several
+  // ranks the one-rank bits (dist/block_sum.hpp), collective; on one rank the
+  // local sum in that order.
+  double block_sum(std::span<const double> values, std::size_t block_size) const {
+    if (!ranks_) return dist::block_ordered_sum(dist::Communicator::world(), 0, values, block_size);
+    return dist::block_ordered_sum(ranks_->comm(), ranks_->first_global_index(), values, block_size);
   }
 
   // DFSPH: record, after every constant-density solve, the reaction of its
@@ -364,9 +420,13 @@ class SphFluid final : public Solver<Real> {
     const std::size_t k = p.find_int_field(kKindField);
     return k == ParticleSet<Real>::npos ? nullptr : p.int_field(k).data();
   }
-  // Fluid particles (not boundary) as of the last evaluation: what averages over the fluid divide by.
-  std::size_t fluid_count(const ParticleSet<Real>& p) const { return kinds(p) ? fluid_count_ : p.size(); }
-  // Boundary particles in the set (0 without the kind field).
+  // Fluid particles (not boundary) as of the last evaluation: what averages
+  // over the fluid divide by (on several ranks: of all ranks).
+  std::size_t fluid_count(const ParticleSet<Real>& p) const {
+    if (kinds(p)) return fluid_count_;
+    return ranks_ ? static_cast<std::size_t>(ranks_->global_count()) : p.size();
+  }
+  // Boundary particles in the set (0 without the kind field; one rank).
   std::size_t boundary_count(const ParticleSet<Real>& p) const { return kinds(p) ? p.size() - fluid_count_ : 0; }
 
   std::vector<std::string> diagnostic_columns() const override {
@@ -410,6 +470,19 @@ class SphFluid final : public Solver<Real> {
     boundary_volumes_ = find_value(values, "sph.boundary_volumes").value_or(0.0) != 0;
   }
 
+  // The evaluations counted for the summary's mean neighbour count (state).
+  // DfsphStepper's re-evaluation after a resume puts them back, so that it
+  // counts as the uninterrupted run's evaluation it repeats.
+  struct EvaluationTally {
+    double neighbour_sum = 0;
+    std::uint64_t evaluations = 0;
+  };
+  EvaluationTally tally() const { return {neighbour_sum_, evaluations_}; }
+  void set_tally(const EvaluationTally& t) {
+    neighbour_sum_ = t.neighbour_sum;
+    evaluations_ = t.evaluations;
+  }
+
   // Interaction lists of the last evaluation (one row per particle; hash search
   // only: the grid computes on the fly and leaves them empty).
   const spatial::NeighbourList<Real>& lists() const { return lists_; }
@@ -426,7 +499,6 @@ class SphFluid final : public Solver<Real> {
   }
   // Empty when these parameters run on several ranks; otherwise what does not (yet).
   std::string distributed_support() const {
-    if (dfsph()) return "sph.method = \"dfsph\"";
     if (params_.neighbour_search != NeighbourSearch::Grid) return "sph.neighbour_search = \"hash\"";
     return {};
   }
@@ -442,7 +514,7 @@ class SphFluid final : public Solver<Real> {
            lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
            hash_.offsets().capacity() * sizeof(std::uint32_t) + hash_.order().capacity() * sizeof(std::uint32_t) +
-           hash_.neighbour_hashes().capacity() * sizeof(std::uint32_t);
+           hash_.neighbour_hashes().capacity() * sizeof(std::uint32_t) + local_bytes();
   }
 
  private:
@@ -451,10 +523,11 @@ class SphFluid final : public Solver<Real> {
     ++evaluations_;
   }
 
-  static std::size_t count_fluid(const ParticleSet<Real>& p) {
+  static std::size_t count_fluid(const ParticleSet<Real>& p) { return count_fluid(p, detail::all_of(p)); }
+  static std::size_t count_fluid(const ParticleSet<Real>& p, IndexRange only) {
     const std::int32_t* kind = kinds(p);
     std::size_t n = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) n += kind && is_boundary(kind[i]) ? 0 : 1;
+    for (std::size_t i = only.begin; i < only.end; ++i) n += kind && is_boundary(kind[i]) ? 0 : 1;
     return n;
   }
 
@@ -463,17 +536,28 @@ class SphFluid final : public Solver<Real> {
   // the boundary particles k within h (b included), W the density kernel
   // `w(r², r)`, stored as its mass. Gathers into b only, in the grid's order:
   // the same bits for any thread count, and on a resume (the flag is state).
+  // On several ranks (halo: the ghosts are in p) for the own particles `own`
+  // alone, the fluid count summed over the ranks, and the ghosts' new masses
+  // exchanged (ψ reads only positions and kinds, which exchange 1 brought).
+  // Returns true when it computed ψ now.
   template <class W>
-  void prepare_boundary(ParticleSet<Real>& p, std::size_t block_size, W&& w) {
+  bool prepare_boundary(ParticleSet<Real>& p, std::size_t block_size, W&& w, IndexRange own,
+                        dist::Halo* halo = nullptr) {
     const std::int32_t* kind = kinds(p);
-    if (!kind) return;
-    if (!counted_) fluid_count_ = count_fluid(p), counted_ = true;
-    if (boundary_volumes_) return;
+    if (!kind) return false;
+    if (!counted_) {
+      const std::size_t mine = count_fluid(p, own);
+      fluid_count_ = ranks_ ? static_cast<std::size_t>(ranks_->comm().sum(std::uint64_t{mine})) : mine;
+      counted_ = true;
+    }
+    if (boundary_volumes_) return false;
     const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
     Real* m = p.mass.data();
     const Real h2 = Real(params_.smoothing_length * params_.smoothing_length), rho0 = Real(params_.rest_density);
-    parallel::for_blocks_pinned("sph_boundary_volume", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
-      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
+    const std::size_t from = own.begin;
+    parallel::for_blocks_pinned("sph_boundary_volume", own.end - own.begin, block_size,
+                                [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_in_cells(grid_, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
         if (!is_boundary(kind[i])) return;
         Real sum = 0;
         detail::for_each_pair(x, y, z, i, ranges, count, h2, [&](std::size_t j, Real, Real, Real, Real r2) {
@@ -482,7 +566,9 @@ class SphFluid final : public Solver<Real> {
         m[i] = rho0 / sum;  // sum ≥ W(0) > 0: b itself
       });
     });
+    if (halo) halo->refresh(ranks_->comm(), p, {"mass"});
     boundary_volumes_ = true;
+    return true;
   }
 
   // The thesis's passes with boundary particles: after the density pass, a
@@ -492,18 +578,21 @@ class SphFluid final : public Solver<Real> {
   // it, p_b = Σ_f p_f W_bf / Σ_f W_bf (0 with no fluid within h), so that a
   // pair's (p_i + p_b) V_b is the fluid particle's own term doubled where the
   // pressure is uniform, as a mirrored fluid particle would push.
-  void mirror_boundary(ParticleSet<Real>& p, std::size_t block_size, const SphLaws<Real>& laws) {
+  // `own`: the particles to compute (on ranks: the own ones; the ghosts' fluid
+  // pressures must be their owners').
+  void mirror_boundary(ParticleSet<Real>& p, std::size_t block_size, const SphLaws<Real>& laws, IndexRange own) {
     const std::int32_t* kind = kinds(p);
     if (!kind) return;
+    const std::size_t from = own.begin, todo = own.end - own.begin;
     const Real rho0 = Real(params_.rest_density);
     const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
     Real *rho = p.density.data(), *pr = p.pressure.data(), *V = scratch_.volume.data(), *PV = scratch_.pressure_volume.data();
     // Two passes: the averages read fluid pressures only, then the entries are written.
     boundary_pressure_.resize(p.size());
     Real* pb = boundary_pressure_.data();
-    parallel::for_blocks_pinned("sph_boundary_pressure", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    parallel::for_blocks_pinned("sph_boundary_pressure", todo, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
       const SphLaws<Real> law = laws;
-      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
+      detail::for_each_in_cells(grid_, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
         if (!is_boundary(kind[i])) return;
         Real weighted = 0, weights = 0;
         detail::for_each_pair(x, y, z, i, ranges, count, law.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
@@ -515,8 +604,8 @@ class SphFluid final : public Solver<Real> {
         pb[i] = weights > Real(0) ? weighted / weights : Real(0);
       });
     });
-    parallel::for_blocks_pinned("sph_boundary_mirror", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
-      for (std::size_t i = b; i < e; ++i) {
+    parallel::for_blocks_pinned("sph_boundary_mirror", todo, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (std::size_t i = from + b; i < from + e; ++i) {
         if (!is_boundary(kind[i])) continue;
         rho[i] = rho0;
         pr[i] = pb[i];
@@ -540,12 +629,12 @@ class SphFluid final : public Solver<Real> {
     used_grid_ = true;
     lists_ = {};
     const SphLaws<Real> k(params_);
-    prepare_boundary(p, ctx.block_size, [&](Real r2, Real) { return k.density.density(k.density.term(Real(1), k.gap2(r2))); });
+    prepare_boundary(p, ctx.block_size, density_weight(k), detail::all_of(p));
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.density");
       pairs = grid_density(grid_, p, k, ctx.block_size, scratch_, kernel_path());
-      mirror_boundary(p, ctx.block_size, k);
+      mirror_boundary(p, ctx.block_size, k, detail::all_of(p));
     }
     mean_neighbours_ = p.empty() ? 0.0 : static_cast<double>(pairs) / static_cast<double>(p.size());
     count_evaluation();
@@ -567,7 +656,6 @@ class SphFluid final : public Solver<Real> {
     const dist::RankOrder<Real>& order = *ctx.ranks;
     if (const std::string no = distributed_support(); !no.empty())
       throw std::invalid_argument("SPH on several ranks: " + no + " does not run on several ranks yet");
-    if (kinds(p)) throw std::invalid_argument("SPH on several ranks: boundary particles do not run on several ranks yet");
     if (!order.cells_fit())
       throw std::runtime_error(
           "SPH on several ranks: the particles spread over more than 2^21 grid cells per axis (the one-rank run "
@@ -579,7 +667,7 @@ class SphFluid final : public Solver<Real> {
       PhaseScope phase(ctx, "forces.halo");
       halo = dist::Halo::find(comm, order.frame(), halo_keys_, order.first_global_index(), order.global_count(),
                               order.cut_keys(), kHaloTail<Real>);
-      halo.insert(comm, p, halo_keys_, kHaloFields);
+      halo.insert(comm, p, halo_keys_, exchange_fields(p));
     }
     {
       PhaseScope phase(ctx, "forces.cells");
@@ -588,11 +676,19 @@ class SphFluid final : public Solver<Real> {
     }
     used_grid_ = true;
     lists_ = {};
+    const SphLaws<Real> k(params_);
+    const IndexRange own = halo.owned();
+    prepare_boundary(p, ctx.block_size, density_weight(k), own, &halo);
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.sph");
-      pairs = halo_density_and_forces(comm, halo, grid_, p, SphLaws<Real>(params_), ctx.block_size, scratch_,
-                                      kernel_path());
+      // With boundary particles: p_b from the ghosts' fluid pressures (exchange
+      // 2), then the ghosts' p_b (exchange 2 again) before the force pass.
+      pairs = halo_density_and_forces(comm, halo, grid_, p, k, ctx.block_size, scratch_, kernel_path(), [&] {
+        if (!kinds(p)) return false;
+        mirror_boundary(p, ctx.block_size, k, own);
+        return true;
+      });
     }
     halo.remove(p, halo_keys_);
     // The mean over all particles: an exact integer sum, then the one-rank division.
@@ -616,7 +712,7 @@ class SphFluid final : public Solver<Real> {
     used_grid_ = true;
     lists_ = {};
     if (!kernel_) kernel_.emplace(params_.kernel, Real(params_.smoothing_length));
-    prepare_boundary(p, ctx.block_size, [&](Real r2, Real r) { return kernel_->w(r2, r); });
+    prepare_boundary(p, ctx.block_size, [&](Real r2, Real r) { return kernel_->w(r2, r); }, detail::all_of(p));
     const std::int32_t* kind = kinds(p);
     if (!(alpha_cap_ > 0) && !p.empty()) {
       // The cap of α: twice the factor of a full lattice neighbourhood at the
@@ -639,6 +735,101 @@ class SphFluid final : public Solver<Real> {
     const std::size_t fluid = fluid_count(p);  // a boundary particle's own pairs are not summed
     mean_neighbours_ = fluid == 0 ? 0.0 : static_cast<double>(pairs) / static_cast<double>(fluid);
     count_evaluation();
+  }
+
+  // DFSPH on several ranks: the evaluation of dfsph_evaluate() on a local set
+  // of this rank's particles among their ghosts (local_: the fields the DFSPH
+  // passes read, exchange 1 of position, velocity, mass and kind), which the
+  // stepper's passes use until the next evaluation (density_change, ...);
+  // ρ (and ψ when computed now) are copied back to p, α stays local.
+  void dfsph_evaluate_ranks(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
+    const dist::RankOrder<Real>& order = *ctx.ranks;
+    const dist::Communicator& comm = order.comm();
+    if (!order.cells_fit())
+      throw std::runtime_error(
+          "DFSPH: the particles spread over more than 2^21 grid cells along an axis, which the grid search (the "
+          "only one DFSPH has) cannot index; a larger smoothing length or a smaller domain");
+    const std::size_t n = p.size();
+    {
+      PhaseScope phase(ctx, "forces.halo");
+      local_ = ParticleSet<Real>(n);
+      for (int a = 0; a < 3; ++a) {
+        std::copy_n(p.position[a].data(), n, local_.position[a].data());
+        std::copy_n(p.velocity[a].data(), n, local_.velocity[a].data());
+      }
+      std::copy_n(p.mass.data(), n, local_.mass.data());
+      std::copy_n(p.id.data(), n, local_.id.data());
+      if (const std::int32_t* kind = kinds(p)) {
+        const std::size_t k = local_.add_int_field(std::string(kKindField));
+        std::copy_n(kind, n, local_.int_field(k).data());
+      }
+      kr_field_ = local_.add_field(std::string(kLocalKappaField), 1, FieldUse::Internal);
+      halo_keys_.assign(order.keys().begin(), order.keys().end());
+      halo_ = dist::Halo::find(comm, order.frame(), halo_keys_, order.first_global_index(), order.global_count(),
+                               order.cut_keys(), kHaloTail<Real>);
+      halo_.insert(comm, local_, halo_keys_, exchange_fields(p));
+      own_ = halo_.owned();
+    }
+    {
+      PhaseScope phase(ctx, "forces.cells");
+      grid_.set_table(params_.cell_table);
+      grid_.view(order.frame(), halo_keys_, halo_.global_index(), ctx.block_size);
+    }
+    used_grid_ = true;
+    lists_ = {};
+    if (!kernel_) kernel_.emplace(params_.kernel, Real(params_.smoothing_length));
+    if (prepare_boundary(local_, ctx.block_size, [&](Real r2, Real r) { return kernel_->w(r2, r); }, own_, &halo_))
+      std::copy_n(local_.mass.data() + own_.begin, n, p.mass.data());
+    const std::int32_t* kind = kinds(local_);
+    if (!(alpha_cap_ > 0) && order.global_count() > 0) {
+      // As dfsph_evaluate(): the largest fluid mass, of all ranks (an exact max).
+      double m[1] = {0};
+      for (std::size_t i = own_.begin; i < own_.end; ++i)
+        if (!kind || !is_boundary(kind[i])) m[0] = std::max(m[0], double(local_.mass[i]));
+      comm.max(m);
+      const double s = std::cbrt(m[0] / params_.rest_density);
+      alpha_cap_ = kAlphaCapFactor * dfsph_lattice_factor(*kernel_, m[0], s);
+    }
+    alpha_.resize(local_.size());
+    std::uint64_t pairs = 0;
+    {
+      PhaseScope phase(ctx, "forces.density");
+      pairs = dfsph_density_and_factor(grid_, local_, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_), kind,
+                                       Real(params_.rest_density), own_);
+      std::copy_n(local_.density.data() + own_.begin, n, p.density.data());
+      if (params_.viscosity > 0) halo_.refresh(comm, local_, {"density"});  // the viscosity's V_j = m_j/ρ_j
+    }
+    const std::uint64_t all = comm.sum(pairs);
+    const std::size_t fluid = fluid_count(p);
+    mean_neighbours_ = fluid == 0 ? 0.0 : static_cast<double>(all) / static_cast<double>(fluid);
+    count_evaluation();
+  }
+
+  // DFSPH on ranks: the local set, its keys and a pass's output.
+  std::size_t local_bytes() const {
+    std::size_t reals = local_out_.capacity(), ints = 0;
+    local_.for_each_array([&](const AlignedVector<Real>& a) { reals += a.capacity(); });
+    local_.for_each_int_array([&](const auto& a) { ints += a.capacity(); });
+    return reals * sizeof(Real) + ints * sizeof(std::int32_t) + local_.id.capacity() * sizeof(local_.id[0]) +
+           halo_keys_.capacity() * sizeof(std::uint64_t);
+  }
+  // What exchange 1 sends: kHaloFields, and the particles' kinds when they have them.
+  static std::vector<std::string> exchange_fields(const ParticleSet<Real>& p) {
+    std::vector<std::string> fields = kHaloFields;
+    if (kinds(p)) fields.emplace_back(kKindField);
+    return fields;
+  }
+  // The thesis's density kernel as prepare_boundary's weight.
+  static auto density_weight(const SphLaws<Real>& k) {
+    return [k](Real r2, Real) { return k.density.density(k.density.term(Real(1), k.gap2(r2))); };
+  }
+  // Own particles' values between p (own only) and local_ (own among ghosts).
+  void to_local(const Vec3Array<Real>& from, Vec3Array<Real>& to) const {
+    for (int a = 0; a < 3; ++a) std::copy(from[a].begin(), from[a].end(), to[a].begin() + own_.begin);
+  }
+  void from_local(const Vec3Array<Real>& from, Vec3Array<Real>& to) const {
+    for (int a = 0; a < 3; ++a)
+      std::copy_n(from[a].begin() + own_.begin, to[a].size(), to[a].begin());
   }
 
   // The thesis's path: spatial hash, lists with density inside the search.
@@ -740,6 +931,16 @@ class SphFluid final : public Solver<Real> {
   AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
   AlignedVector<Real> boundary_pressure_;    // thesis's solver: p_b of the last evaluation (scratch)
   std::vector<std::uint64_t> halo_keys_;     // on ranks: the keys of the own particles and their ghosts (scratch)
+  const dist::RankOrder<Real>* ranks_ = nullptr;  // the last evaluation's rank order (null: one rank)
+  // DFSPH on ranks: the last evaluation's ghosts, the local set (own particles
+  // among them, in global order), the own range in it, κ/ρ's field there and
+  // a pass's output for every local particle.
+  dist::Halo halo_;
+  ParticleSet<Real> local_;
+  IndexRange own_{};
+  std::size_t kr_field_ = 0;
+  AlignedVector<Real> local_out_;
+  static constexpr std::string_view kLocalKappaField = "dfsph_k_over_rho";
   double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
   static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
