@@ -482,6 +482,24 @@ void read_list(const Table& t, ListSource& src) {
   }
 }
 
+// A file a source names (its `file` key): resolved against the scene file's
+// folder, once, to an absolute, lexically normal path written back into the
+// key (parse_scene saves it in the run's scene.toml), and refused when it does
+// not exist. `resume_note` adds to the missing file's message.
+std::filesystem::path resolve_scene_file(const Table& t, std::string& file, std::string_view resume_note = {}) {
+  namespace fs = std::filesystem;
+  const fs::path base = fs::path(std::string(t.reader().file())).parent_path();
+  std::error_code ec;
+  const fs::path path = fs::absolute(base / fs::path(file), ec).lexically_normal();
+  if (ec) t.fail("file", fmt::format("'{}' cannot be made absolute: {}", file, ec.message()));
+  file = path.string();
+  if (!fs::exists(path, ec))
+    t.fail("file", fmt::format("{}: no such file (the scene reads it whenever it is loaded, `swirl run --resume` "
+                               "included{}: put the file back at this path)",
+                               file, resume_note));
+  return path;
+}
+
 // A snapshot source's file: its path resolved and its particles read.
 //
 // The path is relative to the scene file's folder (to the working directory
@@ -498,17 +516,8 @@ void read_list(const Table& t, ListSource& src) {
 // A resume reads it again (the scene is rebuilt before the checkpoint
 // replaces its particles), so the message for a missing file says so.
 void read_snapshot_file(const Table& t, SnapshotSource& src) {
-  namespace fs = std::filesystem;
-  const fs::path base = fs::path(std::string(t.reader().file())).parent_path();
-  std::error_code ec;
-  const fs::path path = fs::absolute(base / fs::path(src.file), ec).lexically_normal();
-  if (ec) t.fail("file", fmt::format("'{}' cannot be made absolute: {}", src.file, ec.message()));
-  src.file = path.string();
-  if (!fs::exists(path, ec))
-    t.fail("file", fmt::format("{}: no such file (the scene reads it whenever it is loaded, `swirl run --resume` "
-                               "included, which rebuilds the scene before the checkpoint replaces its particles: put "
-                               "the file back at this path)",
-                               src.file));
+  const std::filesystem::path path =
+      resolve_scene_file(t, src.file, ", which rebuilds the scene before the checkpoint replaces its particles");
   try {
     std::optional<int> type;
     if (src.part_type) {
@@ -559,16 +568,7 @@ void read_snapshot_file(const Table& t, SnapshotSource& src) {
 // broken file is refused when the scene is loaded, and validation counts the
 // particles that will be built. A resume reads it again.
 void read_mesh_file(const Table& t, ObstacleSource& src) {
-  namespace fs = std::filesystem;
-  const fs::path base = fs::path(std::string(t.reader().file())).parent_path();
-  std::error_code ec;
-  const fs::path path = fs::absolute(base / fs::path(src.file), ec).lexically_normal();
-  if (ec) t.fail("file", fmt::format("'{}' cannot be made absolute: {}", src.file, ec.message()));
-  src.file = path.string();
-  if (!fs::exists(path, ec))
-    t.fail("file", fmt::format("{}: no such file (the scene reads it whenever it is loaded, `swirl run --resume` "
-                               "included: put the file back at this path)",
-                               src.file));
+  const std::filesystem::path path = resolve_scene_file(t, src.file);
   try {
     src.mesh = std::make_shared<const io::TriangleMesh>(io::read_triangle_mesh(path));
   } catch (const io::IoError& e) {
