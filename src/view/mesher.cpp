@@ -96,11 +96,11 @@ void Mesher::loop() {
       error = e.what();
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (message) publish_(message);
+    // Counted before it is published, so that whoever has the message sees it
+    // in stats(); not busy only once it is published.
     std::uint64_t failed = 0;
     {
       std::lock_guard lock(mutex_);
-      working_ = false;
       if (message) {
         ++stats_.meshes;
         stats_.seconds += seconds;
@@ -111,6 +111,11 @@ void Mesher::loop() {
       } else {
         failed = ++stats_.failed;
       }
+    }
+    if (message) publish_(message);
+    {
+      std::lock_guard lock(mutex_);
+      working_ = false;
     }
     std::uint64_t power = 1;
     while (power < failed) power *= 10;
