@@ -213,11 +213,11 @@ TEST_F(LiveSession, SurfaceMeshesEncloseTheFluidsVolume) {
 TEST_F(LiveSession, MeshesAreMadeForAndSentToTheViewersWhoAskOnly) {
   start();
   Viewer asks(port_), not_asking(port_);
-  const auto meshes_made = [&](Viewer& v) {  // from a status: the server's count of meshes made
-    const std::string st = test::next_text(v, "status");
-    const auto at = st.find(R"("surface":{"meshes":)");
-    return at == std::string::npos ? ~std::uint64_t{0} : std::stoull(st.substr(at + 20));
+  const auto meshes_made_in = [](const std::string& status) {  // the server's count of meshes made
+    const auto at = status.find(R"("surface":{"meshes":)");
+    return at == std::string::npos ? ~std::uint64_t{0} : std::stoull(status.substr(at + 20));
   };
+  const auto meshes_made = [&](Viewer& v) { return meshes_made_in(test::next_text(v, "status")); };
   for (int k = 0; k < 10; ++k) not_asking.frame();
   EXPECT_EQ(meshes_made(not_asking), 0u) << "nobody asked: no mesh made";
   asks.send(encode_control(control::Surface{true}));
@@ -230,12 +230,24 @@ TEST_F(LiveSession, MeshesAreMadeForAndSentToTheViewersWhoAskOnly) {
   }
   asks.send(encode_control(control::Surface{false}));
   std::this_thread::sleep_for(300ms);  // a mesh in the making when it was turned off may still finish
-  const std::uint64_t after_off = meshes_made(not_asking);
-  std::this_thread::sleep_for(1s);
-  std::uint64_t later = meshes_made(not_asking);
-  for (int k = 0; k < 3; ++k) later = meshes_made(not_asking);  // the newest status
+  // A slow reader's socket holds a backlog of older statuses; the first one
+  // showing a pause (or resume) it asked for is newer than that request.
+  const auto status_after = [&](bool pause) {
+    not_asking.send(encode_control(pause ? Control{control::Pause{}} : Control{control::Resume{}}));
+    const std::string flag = pause ? R"("paused":true)" : R"("paused":false)";
+    for (;;) {
+      std::string st = test::next_text(not_asking, "status");
+      if (st.find(flag) != std::string::npos) return st;
+    }
+  };
+  const std::string off = status_after(true);
+  const std::uint64_t after_off = meshes_made_in(off);
+  status_after(false);
+  std::this_thread::sleep_for(1s);  // the run goes on without a mesh
+  const std::string later = status_after(true);
   EXPECT_GT(after_off, 0u);
-  EXPECT_EQ(later, after_off) << "no viewer wants the surface: no mesh made";
+  EXPECT_GT(field_u64(later, "step"), field_u64(off, "step")) << "steps were made after the surface went off";
+  EXPECT_EQ(meshes_made_in(later), after_off) << "no viewer wants the surface: no mesh made";
 }
 
 // --surface: a viewer starts with the surface on, without asking.
