@@ -6,7 +6,8 @@
 # bytes; a blow-up stops every rank with the one-rank
 # message and keeps the frames; a scene part that is not distributed yet is
 # refused once with status 2 and leaves no folder; more ranks than particles
-# are refused.
+# are refused; SIGINT to mpirun stops every rank with a checkpoint that
+# resumes to the one-rank bytes.
 #
 #   run_on_ranks.sh MPIEXEC SWIRL EXAMPLES   (EXAMPLES: the examples/ folder)
 set -uo pipefail
@@ -167,6 +168,41 @@ on_ranks 4 run "$scene" --set particles.0.spacing=0.29 --steps 2 --out "$out/few
 [ "$status" -eq 2 ] || fail "1 particle on 4 ranks: status $status (want 2)"
 grep -q "1 particles on 4 MPI ranks: every rank needs at least one particle" "$out/stderr" ||
   fail "1 particle on 4 ranks: not said"
+
+# 9. SIGINT to mpirun (a user's Ctrl-C) stops every rank after the same step,
+#    rank 0 writes a checkpoint and says so once, and no rank is left running;
+#    resumed on 3 ranks to a later step, the run ends with the bytes of an
+#    uninterrupted one-rank run. (mpirun's own status is not swirl's: it only
+#    has to be a failure.)
+dir="$out/sigint"
+"$mpiexec" -n 2 --oversubscribe --timeout 240 "$swirl" run "$scene" "${small[@]}" --steps 100000 \
+  --checkpoint-every-steps 1000 --out "$dir" >"$out/stdout" 2>"$out/stderr" &
+launcher=$!
+for _ in $(seq 600); do [ -e "$dir/particles_000003.vtp" ] && break; sleep 0.1; done
+kill -INT "$launcher"
+wait "$launcher"
+status=$?
+[ "$status" -ne 0 ] || fail "SIGINT on 2 ranks: status 0"
+[ "$(grep -c 'swirl run: interrupted at t = ' "$out/stdout" "$out/stderr" | awk -F: '{s += $2} END {print s}')" -eq 1 ] ||
+  { fail "SIGINT on 2 ranks: the interruption is not reported exactly once"; cat "$out/stdout" "$out/stderr"; }
+sleep 1
+pgrep -f -- "--out $dir" >/dev/null && fail "SIGINT on 2 ranks: a rank is still running"
+checkpoint=$(ls "$dir"/checkpoints/checkpoint_*.swc 2>/dev/null | tail -1)
+if [ -z "$checkpoint" ]; then
+  fail "SIGINT on 2 ranks: no checkpoint written"
+else
+  stopped=$((10#$(basename "$checkpoint" .swc | sed 's/checkpoint_//')))
+  echo "SIGINT on 2 ranks: stopped at step $stopped"
+  target=$(((stopped / 10 + 2) * 10))
+  on_ranks 1 run "$scene" "${small[@]}" --steps "$target" --checkpoint-every-steps 10 --out "$out/sigint_ref"
+  [ "$status" -eq 0 ] || { fail "SIGINT reference: status $status"; cat "$out/stderr"; }
+  on_ranks 3 run --resume "$dir" --steps $((target - stopped)) --checkpoint-every-steps 10
+  [ "$status" -eq 0 ] || { fail "SIGINT resumed on 3 ranks: status $status"; cat "$out/stderr"; }
+  last_frame=$(printf 'particles_%06d.vtp' $((target / 10)))
+  for f in "$last_frame" diagnostics.csv "checkpoints/$(printf 'checkpoint_%012d.swc' "$target")"; do
+    cmp -s "$out/sigint_ref/$f" "$dir/$f" || fail "SIGINT on 2 ranks, resumed on 3: $f differs from the uninterrupted one-rank run"
+  done
+fi
 
 [ "$failures" -eq 0 ] && echo "run_on_ranks: all checks passed"
 exit $((failures > 0))

@@ -7,6 +7,7 @@
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "scene/scene_test_util.hpp"
 #include "swirl/scene/keys.hpp"
@@ -53,6 +54,26 @@ TEST(KeysDoc, EveryDeclaredKeyIsInItsSectionsTable) {
     for (const auto& spec : kind.keys)
       EXPECT_NE(key_table_markdown(kind.name).find("| `" + std::string(spec.key) + "` |"), std::string::npos)
           << kind.name << "." << spec.key;
+}
+
+// The scene fuzzer's dictionary (tests/fuzz/scene.dict) names every key and
+// every source kind, so that libFuzzer's mutations reach the newest keys too.
+TEST(KeysDoc, TheFuzzDictionaryNamesEveryKey) {
+  const auto path = std::filesystem::path(SWIRL_SOURCE_DIR) / "tests" / "fuzz" / "scene.dict";
+  std::ifstream in(path, std::ios::binary);
+  ASSERT_TRUE(in) << "cannot read " << path;
+  const std::string dict{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const auto expect_named = [&](std::string_view dotted) {
+    const std::string leaf(dotted.substr(dotted.rfind('.') + 1));
+    EXPECT_NE(dict.find("=\"" + leaf + "\""), std::string::npos) << "tests/fuzz/scene.dict lacks " << dotted;
+  };
+  for (const auto& spec : scene_keys()) expect_named(spec.key);
+  for (const auto& spec : probe_keys()) expect_named(spec.key);
+  for (const auto& kind : source_kinds()) {
+    EXPECT_NE(dict.find("\\\"" + std::string(kind.name) + "\\\""), std::string::npos)
+        << "tests/fuzz/scene.dict lacks the kind \"" << kind.name << "\" (as str_NAME=\"\\\"NAME\\\"\")";
+    for (const auto& spec : kind.keys) expect_named(spec.key);
+  }
 }
 
 }  // namespace
