@@ -934,6 +934,14 @@ WalkCounts EssentialTree<Real>::evaluate(GravityField<Real>& out) {
   return counts;
 }
 
+template <class Real>
+void EssentialTree<Real>::add_walk_costs(std::span<std::uint64_t> out) const {
+  if (out.size() != own_count_) throw std::logic_error("essential tree: walk costs for another particle count");
+  std::vector<std::uint64_t> all(tree_.x().size(), 0);
+  tree_.add_walk_costs(all);
+  for (std::size_t i = 0; i < own_count_; ++i) out[i] += all[own_offset_ + i];
+}
+
 template KeyCube global_key_cube<float>(const dist::Communicator&, const ParticleSet<float>&);
 template KeyCube global_key_cube<double>(const dist::Communicator&, const ParticleSet<double>&);
 template void octree_keys<float>(const ParticleSet<float>&, const KeyCube&, std::vector<std::uint64_t>&);

@@ -67,6 +67,11 @@ std::vector<std::uint64_t> GravityForce<Real>::rank_cuts(const dist::Communicato
 }
 
 template <class Real>
+void GravityForce<Real>::add_rank_costs(std::span<std::uint64_t> costs) const {
+  if (walked_on_ranks_ && costs.size() == field_.size()) essential_.add_walk_costs(costs);
+}
+
+template <class Real>
 void GravityForce<Real>::declare_fields(ParticleSet<Real>& p) {
   p.add_field("potential", 1);
 }
@@ -94,6 +99,7 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
                      KeyCube{f.corner, f.root_side()}, tree_.linear_settings(), ctx.block_size);
     const auto t1 = std::chrono::steady_clock::now();
     const WalkCounts counts = essential_.evaluate(field_);
+    walked_on_ranks_ = true;
     // The one-rank figures: exact integer sums over ranks, then its divisions.
     std::uint64_t sums[2] = {counts.nodes, counts.multipoles + counts.pairs};
     order.comm().sum(sums);

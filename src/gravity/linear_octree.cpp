@@ -697,6 +697,19 @@ WalkCounts LinearOctree<Real>::evaluate_groups(GravityField<Real>& out) {
 }
 
 template <class Real>
+void LinearOctree<Real>::add_walk_costs(std::span<std::uint64_t> out) const {
+  if (out.size() != x_.size() || group_counts_.size() != groups_.size() || !active_slot_.empty())
+    throw std::logic_error("linear octree: walk costs need the last evaluation to be a full group walk");
+  const LinearNodes<Real>& t = nodes_;
+  for (std::size_t g = 0; g < groups_.size(); ++g) {
+    const std::uint32_t b = t.begin[groups_[g]], e = t.end[groups_[g]];
+    const WalkCounts& c = group_counts_[g];  // count × list length each
+    const std::uint64_t per_particle = (c.multipoles + c.pairs) / std::uint64_t(e - b);
+    for (std::uint32_t s = b; s < e; ++s) out[order_[s]] += per_particle;
+  }
+}
+
+template <class Real>
 WalkCounts LinearOctree<Real>::evaluate(GravityField<Real>& out, std::size_t block_size, const ActiveSet& active) {
   const std::size_t n = x_.size();
   if (assembled_ && !active.all()) throw std::invalid_argument("linear octree: an assembled tree evaluates every group");

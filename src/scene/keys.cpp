@@ -269,6 +269,11 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "simulation.block_size", .section = "simulation", .unit = "particles", .range = kAtLeastOne,
                      .doc = "particles per parallel work block; results are identical for any thread count at a given block size"},
             in_scene(&Scene::block_size)));
+  add(field(SceneKey{.key = "simulation.rebalance_threshold", .section = "simulation", .unit = "–", .range = kAtLeastOne,
+                     .doc = "on several MPI ranks: the ranks' key ranges are cut anew when the largest rank's work "
+                            "(1 per particle plus its neighbour candidates or interaction-list entries in the last "
+                            "step) over the mean passes this; 1 = at every sort. Changes no result, only the balance"},
+            in_scene(&Scene::rebalance_threshold)));
   SceneKey dt_max{.key = "simulation.dt_max", .section = "simulation", .type = KeyType::Number, .unit = "s",
                   .range = kPositive,
                   .doc = "only with `dt = \"adaptive\"`: the largest step; required when the default does not apply "

@@ -782,7 +782,13 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   sim.stepper().add_metrics(summary.metrics);
   if (const auto error = diagnostics->energy_error()) summary.metrics.emplace_back("relative_energy_error", *error);
   if (sim.ranks()) {
-    if (sim.ranks()->active()) summary.metrics.emplace_back("sorts", double(sim.ranks()->sorts()));
+    if (sim.ranks()->active()) {
+      summary.metrics.emplace_back("sorts", double(sim.ranks()->sorts()));
+      // The balance (dist/rank_order.hpp): how often the cuts moved, and the
+      // largest rank's work over the mean at the last sort.
+      summary.metrics.emplace_back("rebalances", double(sim.ranks()->rebalances()));
+      summary.metrics.emplace_back("rank_imbalance", sim.ranks()->imbalance());
+    }
   } else if (sim.order().active()) {
     summary.metrics.emplace_back("sorts", double(sim.order().sorts()));
   }

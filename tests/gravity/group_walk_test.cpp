@@ -283,6 +283,30 @@ TYPED_TEST(GroupWalkTest, SimdKernelsMatchTheScalarPathThroughTheWalk) {
   }
 }
 
+// The walk's work per particle (add_walk_costs, what MPI ranks balance by):
+// each particle's interaction-list length, summing to the walk's counts.
+TYPED_TEST(GroupWalkTest, WalkCostsAreEachParticlesListLength) {
+  using Real = TypeParam;
+  const ParticleSet<Real> p = awkward_set<Real>(2000);
+  LinearOctree<Real> tree;
+  tree.build(p, walk_settings(Walk::Group, Multipole::Quadrupole, Criterion::Barnes, 0.6), 64);
+  GravityField<Real> f;
+  const WalkCounts counts = tree.evaluate(f, 64);
+  std::vector<std::uint64_t> costs(p.size(), 1);
+  tree.add_walk_costs(costs);
+  std::uint64_t total = 0;
+  for (const std::uint64_t c : costs) {
+    EXPECT_GE(c, 2u);
+    EXPECT_LE(c, p.size());  // 1 + at most every other particle
+    total += c - 1;
+  }
+  EXPECT_EQ(total, counts.multipoles + counts.pairs);
+  // The clump (one leaf larger than a group) shares one list: one cost.
+  for (std::size_t i = 1; i < 100; ++i) EXPECT_EQ(costs[i], costs[0]);
+  std::vector<std::uint64_t> wrong(p.size() - 1);
+  EXPECT_THROW(tree.add_walk_costs(wrong), std::logic_error);
+}
+
 TEST(GroupWalkSettings, WalkNamesParseAndBadNamesAreRefused) {
   EXPECT_EQ(parse_walk("group"), Walk::Group);
   EXPECT_EQ(parse_walk("particle"), Walk::Particle);

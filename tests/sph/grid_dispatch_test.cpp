@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -195,6 +196,35 @@ TYPED_TEST(GridDispatchTest, EveryCopyIsBitIdenticalForOneTwoAndThreeThreads) {
 // The dispatcher calls the copy it was told to: the copy reports its own float
 // batch width, and copies of different widths sum in different orders, so
 // their results differ in the last bits somewhere.
+// The passes' work per particle (grid_candidates, what MPI ranks balance by)
+// against the brute-force neighbours: every neighbour is a candidate, the
+// particles of one cell share one count, and a range's counts are the whole
+// pass's.
+TEST(GridCandidates, BoundTheNeighboursAndAreOnePerCell) {
+  const Box<double> box;
+  const auto& grid = box.fluid.grid();
+  const std::size_t n = box.p.size();
+  std::vector<std::uint64_t> all(n);
+  sph::grid_candidates(grid, {0, std::uint32_t(n)}, kBlock, std::span<std::uint64_t>(all));
+  const auto& x = box.p.position;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t neighbours = 0;  // itself included, as the candidates
+    for (std::size_t j = 0; j < n; ++j) {
+      const double dx = x.x[i] - x.x[j], dy = x.y[i] - x.y[j], dz = x.z[i] - x.z[j];
+      neighbours += dx * dx + dy * dy + dz * dz < box.k.h2;
+    }
+    ASSERT_GE(all[i], neighbours) << "particle " << i;
+    ASSERT_LE(all[i], n);
+    if (i > 0 && grid.keys()[i] == grid.keys()[i - 1]) {
+      ASSERT_EQ(all[i], all[i - 1]) << "one cell, one count";
+    }
+  }
+  std::vector<std::uint64_t> part(1000);
+  sph::grid_candidates(grid, {500, 1500}, kBlock, std::span<std::uint64_t>(part));
+  EXPECT_TRUE(std::equal(part.begin(), part.end(), all.begin() + 500));
+  EXPECT_THROW(sph::grid_candidates(grid, {0, 10}, kBlock, std::span<std::uint64_t>(part)), std::invalid_argument);
+}
+
 TEST(GridDispatch, EachCopyRunsAtItsOwnWidth) {
   for (simd::Isa isa : usable_isas()) {
     simd::ScopedIsa scope(isa);

@@ -10,8 +10,13 @@
 //   2. the frame from the global bounding box (dist::global_key_frame: the
 //      frame ParticleOrder would compute for all the particles), every
 //      particle's key in it;
-//   3. cut keys that split the particles evenly (dist::balanced_cut_keys, one
-//      unit of cost per particle), then distribute_in_key_order(): every
+//   3. cut keys that split the particles' cost evenly (dist::balanced_cut_keys)
+//      — a cost per particle of 1 plus the solvers' counts of its work in the
+//      last evaluation (set_cost_rule: Solver::add_rank_costs, e.g. neighbour
+//      candidates, interaction-list entries; integers, never timings) — kept
+//      from the last sort while the imbalance they give (the largest rank's
+//      cost over the mean) stays within the rebalance threshold; then
+//      distribute_in_key_order(): every
 //      particle moves to the rank whose key range holds it, each rank's
 //      particles sorted by (key, previous global index), which is the one-rank
 //      stable sort whatever the rank count; a cut rule (set_cut_rule: the
@@ -19,9 +24,9 @@
 //      gravity tree's group boundaries.
 // So keys(), frame() and the particles' order are the one-rank ones, cut into
 // ranges; where the cuts fall changes no result (the halo's invariants,
-// dist/halo.hpp), only the balance. The cuts are recomputed at every sort:
-// balancing by the last step's interaction counts instead of by count is
-// still to do (issue 19 item 2).
+// dist/halo.hpp), only the balance. A kept cut is a key of the last frame
+// read in the new one (the frame follows the global box): still a valid
+// partition, whose imbalance is measured before it is kept.
 //
 // adopt(): a run's ranks each build (or read from a checkpoint) the whole
 // set, and each keeps its share: an even slice of the memory order, or, for a
@@ -77,6 +82,18 @@ class RankOrder {
                                                            std::vector<std::uint64_t> cuts)>;
   void set_cut_rule(CutRule rule) { cut_rule_ = std::move(rule); }
 
+  // Adds each own particle's work in the last evaluation to costs (one per
+  // particle, in the particles' current order; see the header).
+  using CostRule = std::function<void(std::span<std::uint64_t> costs)>;
+  void set_cost_rule(CostRule rule) { cost_rule_ = std::move(rule); }
+  // New cuts when the imbalance of the current ones passes this (≥ 1; 1:
+  // new cuts at every sort).
+  void set_rebalance_threshold(double threshold) {
+    if (!(threshold >= 1) || !std::isfinite(threshold))
+      throw std::invalid_argument("RankOrder: the rebalance threshold must be finite and ≥ 1");
+    rebalance_threshold_ = threshold;
+  }
+
   // p holds every particle, the same on every rank, in the one-rank memory
   // order (a scene's initial state, or a checkpoint's when resumed): keeps
   // this rank's share (see the header).
@@ -85,6 +102,7 @@ class RankOrder {
     const auto ranks = static_cast<std::size_t>(comm_->size()), r = static_cast<std::size_t>(comm_->rank());
     global_count_ = n;
     valid_ = false;
+    balanced_ = false;
     keys_.clear();
     cut_keys_.assign(ranks - 1, 0);
     ++epoch_;
@@ -133,8 +151,20 @@ class RankOrder {
     frame_ = global_key_frame(*comm_, p, request_, fits);
     cells_fit_ = fits;
     keys_ = keys_in_frame(frame_, p);
-    cut_keys_ = balanced_cut_keys(*comm_, keys_, std::vector<std::uint64_t>(keys_.size(), 1));
+    costs_.assign(keys_.size(), 1);
+    if (cost_rule_) cost_rule_(costs_);
+    bool rebalance = !balanced_;
+    if (!rebalance) {  // an empty rank (cost 0: every particle costs ≥ 1) always rebalances
+      const std::vector<std::uint64_t> held = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
+      rebalance = std::find(held.begin(), held.end(), 0) != held.end() || dist::imbalance(held) > rebalance_threshold_;
+    }
+    if (rebalance) {
+      cut_keys_ = balanced_cut_keys(*comm_, keys_, costs_);
+      balanced_ = true;
+      ++rebalances_;
+    }
     if (cut_rule_) cut_keys_ = cut_rule_(keys_, std::move(cut_keys_));
+    rank_costs_ = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
     const Distribution d = distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_);
     first_ = d.first_global_index;
     global_count_ = d.global_count;
@@ -157,8 +187,16 @@ class RankOrder {
   bool cells_fit() const { return cells_fit_; }
   std::uint64_t epoch() const { return epoch_; }
   std::uint64_t sorts() const { return sorts_; }
+  // Sorts that chose new cuts (the others kept the last ones).
+  std::uint64_t rebalances() const { return rebalances_; }
+  // The cost each rank's range held at the last sort, and its imbalance
+  // (largest over mean; 1 before the first sort).
+  std::span<const std::uint64_t> rank_costs() const { return rank_costs_; }
+  double imbalance() const { return rank_costs_.empty() ? 1.0 : dist::imbalance(rank_costs_); }
   std::size_t sent_away() const { return sent_away_; }
-  std::size_t bytes() const { return (keys_.capacity() + cut_keys_.capacity()) * sizeof(std::uint64_t); }
+  std::size_t bytes() const {
+    return (keys_.capacity() + cut_keys_.capacity() + costs_.capacity() + rank_costs_.capacity()) * sizeof(std::uint64_t);
+  }
 
  private:
   void remember(ParticleSet<Real>& p, std::size_t /*block_size*/) {
@@ -188,6 +226,12 @@ class RankOrder {
   const Communicator* comm_;
   spatial::OrderRequest request_;
   CutRule cut_rule_;
+  CostRule cost_rule_;
+  double rebalance_threshold_ = 1.05;
+  bool balanced_ = false;  // cut_keys_ were balanced by a sort (adopt's are not)
+  std::vector<std::uint64_t> costs_;       // per own particle, at the last sort (before it)
+  std::vector<std::uint64_t> rank_costs_;  // per rank, at the last sort
+  std::uint64_t rebalances_ = 0;
   spatial::KeyFrame frame_;
   bool cells_fit_ = true;
   bool valid_ = false;

@@ -90,7 +90,7 @@ class Solver {
   virtual void add_acceleration(ParticleSet<Real>& particles, const SolverContext<Real>& ctx) = 0;
 
   // On several ranks: where the ranks' key ranges may end. Given this rank's
-  // keys (dist::RankOrder's, this evaluation's) and cuts balanced by count,
+  // keys (dist::RankOrder's, this evaluation's) and cuts balanced by cost,
   // returns the cuts this solver's passes need (self-gravity: on group
   // boundaries of the global tree). Collective; the same cuts on every rank.
   virtual std::vector<std::uint64_t> rank_cuts(const dist::Communicator& /*comm*/,
@@ -98,6 +98,15 @@ class Solver {
                                                std::vector<std::uint64_t> cuts) const {
     return cuts;
   }
+
+  // On several ranks: adds to costs (one per particle of this rank, in the
+  // particles' current order) each particle's work in this solver's last
+  // evaluation, as an integer count of the same kind for every particle
+  // (neighbour candidates, interaction-list entries): what dist::RankOrder
+  // balances the ranks by. Never a timing, so that a run decides the same
+  // cuts every time. Adds nothing when the solver has no evaluation of these
+  // particles yet (e.g. right after a resume).
+  virtual void add_rank_costs(std::span<std::uint64_t> /*costs*/) const {}
 
   // Time-step conditions.
   virtual ScanNeeds scan_needs() const { return {}; }

@@ -137,6 +137,9 @@ class EssentialTree {
   // The field of this rank's particles (out resized to their count, in p's
   // order): the one-rank group walk's bits. Not collective.
   WalkCounts evaluate(GravityField<Real>& out);
+  // After evaluate(): adds to out (one entry per own particle, in p's order)
+  // each one's interaction-list length (LinearOctree::add_walk_costs).
+  void add_walk_costs(std::span<std::uint64_t> out) const;
 
   const EssentialTreeStats& stats() const { return stats_; }
   // The assembled tree (nodes and particles in this rank's layout).

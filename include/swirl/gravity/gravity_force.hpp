@@ -68,6 +68,8 @@ class GravityForce final : public Solver<Real> {
   // On ranks: cuts on group boundaries of the global tree (group_aligned_cuts).
   std::vector<std::uint64_t> rank_cuts(const dist::Communicator& comm, std::span<const std::uint64_t> keys,
                                        std::vector<std::uint64_t> cuts) const override;
+  // On ranks: each particle's interaction-list length in the last walk.
+  void add_rank_costs(std::span<std::uint64_t> costs) const override;
   // Empty when these settings run on several ranks (the linear octree's group
   // walk, as a view of the order: the locally essential tree); otherwise what does not.
   std::string distributed_support() const;
@@ -103,6 +105,7 @@ class GravityForce final : public Solver<Real> {
   SelfGravityOptions options_;
   BarnesHut<Real> tree_;
   EssentialTree<Real> essential_;  // on several ranks
+  bool walked_on_ranks_ = false;     // essential_ has evaluated the particles now held
   Fmm<Real> fmm_;
   GravityField<Real> field_;
   GravityStats stats_;

@@ -205,6 +205,13 @@ class LinearOctree {
   // per-thread lists and the groups' costs for the next call.
   WalkCounts evaluate(GravityField<Real>& out, std::size_t block_size, const ActiveSet& active = {});
 
+  // After a full group walk: adds to out[order()[s]] (out: one entry per
+  // particle) the length of the interaction list particle s was evaluated
+  // with — its group's particle and cell sources, itself excluded. An integer
+  // measure of the walk's work per particle, for balancing ranks
+  // (dist/rank_order.hpp): the same for every run, unlike a timing.
+  void add_walk_costs(std::span<std::uint64_t> out) const;
+
   // The group walk's groups (node indices, in curve order), and the order the
   // last group walk handed them to the threads (indices into groups()).
   std::span<const std::uint32_t> groups() const { return groups_; }

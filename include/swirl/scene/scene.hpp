@@ -245,6 +245,8 @@ struct Scene {
   std::optional<double> end_time;          // simulation.end_time, s (exactly one of end_time, steps)
   std::optional<std::uint64_t> steps;      // simulation.steps
   std::size_t block_size = 1024;           // simulation.block_size: particles per work block, ≥ 1
+  double rebalance_threshold = 1.05;       // simulation.rebalance_threshold: on MPI ranks, new cuts when the
+                                           // largest rank's cost over the mean passes it (≥ 1; dist/rank_order.hpp)
 
   // Time-step control (docs/stability.md). dt = "adaptive" chooses every step
   // from the conditions below (each solver's add_limits(), force/solver.hpp); a fixed dt is checked

@@ -29,6 +29,7 @@ Simulation<Real> build_simulation(const scene::Scene& scene) {
   SimulationSettings settings;
   settings.dt = scene.dt;
   settings.block_size = scene.block_size;
+  settings.rebalance_threshold = scene.rebalance_threshold;
   settings.adaptive = scene.adaptive_dt;
   settings.dt_min = scene.dt_min;
   // A particle further outside than the kernel support has left the box (the guard).

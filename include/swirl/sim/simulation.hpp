@@ -99,6 +99,8 @@ struct SimulationSettings {
   // has left the domain (scenes set the SPH kernel support h); 0: no check.
   double escape_length = 0;
   OnBlowUp on_blow_up = OnBlowUp::Stop;
+  // Several ranks: new cuts when the ranks' cost imbalance passes this (≥ 1; dist/rank_order.hpp).
+  double rebalance_threshold = 1.05;
 };
 
 // Where a run is in time, and the adaptive controller's memory.
@@ -132,7 +134,10 @@ class Simulation {
   // resume() then keeps this rank's share (see the header).
   void distribute(const dist::Communicator& comm) {
     if (started_) throw std::logic_error("Simulation::distribute() after start()");
-    if (comm.distributed()) ranks_ = std::make_unique<dist::RankOrder<Real>>(comm);
+    if (comm.distributed()) {
+      ranks_ = std::make_unique<dist::RankOrder<Real>>(comm);
+      ranks_->set_rebalance_threshold(settings_.rebalance_threshold);
+    }
   }
   // The rank order on several ranks, or null.
   const dist::RankOrder<Real>* ranks() const { return ranks_.get(); }
@@ -184,6 +189,9 @@ class Simulation {
       ranks_->set_cut_rule([this](std::span<const std::uint64_t> keys, std::vector<std::uint64_t> cuts) {
         for (const auto& s : solvers_) cuts = s->rank_cuts(ranks_->comm(), keys, std::move(cuts));
         return cuts;
+      });
+      ranks_->set_cost_rule([this](std::span<std::uint64_t> costs) {
+        for (const auto& s : solvers_) s->add_rank_costs(costs);
       });
     }
     if (request.keep_within > 0) particles_.add_field(std::string(spatial::ParticleOrder<Real>::kReferenceField), 3, FieldUse::Internal);

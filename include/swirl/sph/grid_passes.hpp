@@ -35,6 +35,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -102,6 +103,27 @@ inline void check_range(IndexRange only, std::size_t n) {
 }
 
 }  // namespace detail
+
+// The neighbour candidates of each particle of `only`: how many particles the
+// cells its passes scan hold (itself included), into out[i − only.begin]. The
+// passes' work per particle as an integer, for balancing the ranks of a
+// distributed run (force/solver.hpp, add_rank_costs).
+template <class Real>
+void grid_candidates(const spatial::SortedCellGrid<Real>& grid, IndexRange only, std::size_t block_size,
+                     std::span<std::uint64_t> out) {
+  if (only.begin > only.end || out.size() != std::size_t(only.end - only.begin))
+    throw std::invalid_argument("SPH grid candidates: the output is not one entry per particle of the range");
+  const std::size_t from = only.begin;
+  parallel::for_blocks("sph_grid_candidates", out.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+    detail::for_each_cell(grid, from + b, from + e,
+                          [&](std::size_t first, std::size_t last, const spatial::NeighbourRanges& ranges, int count) {
+                            std::uint64_t candidates = 0;
+                            for (int r = 0; r < count; ++r)
+                              candidates += ranges[std::size_t(r)].end - ranges[std::size_t(r)].begin;
+                            for (std::size_t i = first; i < last; ++i) out[i - from] = candidates;
+                          });
+  });
+}
 
 // Density and pressure of every particle; returns the neighbour pairs found
 // (self excluded), for the mean neighbour count.

@@ -497,6 +497,15 @@ class SphFluid final : public Solver<Real> {
     if (!(mu >= 0) || !std::isfinite(mu)) throw std::invalid_argument("SPH: viscosity must be finite and ≥ 0");
     params_.viscosity = mu;
   }
+  // On ranks: each fluid particle's neighbour candidates in the last
+  // evaluation (grid_candidates); a boundary particle adds nothing, being
+  // skipped as a particle by the passes that dominate (the base cost per
+  // particle is dist::RankOrder's).
+  void add_rank_costs(std::span<std::uint64_t> costs) const override {
+    if (rank_costs_.size() != costs.size()) return;
+    for (std::size_t i = 0; i < costs.size(); ++i) costs[i] += rank_costs_[i];
+  }
+
   // Empty when these parameters run on several ranks; otherwise what does not (yet).
   std::string distributed_support() const {
     if (params_.neighbour_search != NeighbourSearch::Grid) return "sph.neighbour_search = \"hash\"";
@@ -678,6 +687,7 @@ class SphFluid final : public Solver<Real> {
     lists_ = {};
     const SphLaws<Real> k(params_);
     const IndexRange own = halo.owned();
+    record_rank_costs(p, own, ctx.block_size);
     prepare_boundary(p, ctx.block_size, density_weight(k), own, &halo);
     std::uint64_t pairs = 0;
     {
@@ -777,6 +787,7 @@ class SphFluid final : public Solver<Real> {
     }
     used_grid_ = true;
     lists_ = {};
+    record_rank_costs(local_, own_, ctx.block_size);
     if (!kernel_) kernel_.emplace(params_.kernel, Real(params_.smoothing_length));
     if (prepare_boundary(local_, ctx.block_size, [&](Real r2, Real r) { return kernel_->w(r2, r); }, own_, &halo_))
       std::copy_n(local_.mass.data() + own_.begin, n, p.mass.data());
@@ -803,6 +814,16 @@ class SphFluid final : public Solver<Real> {
     const std::size_t fluid = fluid_count(p);
     mean_neighbours_ = fluid == 0 ? 0.0 : static_cast<double>(all) / static_cast<double>(fluid);
     count_evaluation();
+  }
+
+  // On ranks, after the grid view over this rank's particles among their
+  // ghosts (p: that set; own: this rank's range in it): add_rank_costs's figures.
+  void record_rank_costs(const ParticleSet<Real>& p, IndexRange own, std::size_t block_size) {
+    rank_costs_.assign(own.end - own.begin, 0);
+    grid_candidates(grid_, own, block_size, std::span<std::uint64_t>(rank_costs_));
+    if (const std::int32_t* kind = kinds(p))
+      for (std::size_t i = own.begin; i < own.end; ++i)
+        if (is_boundary(kind[i])) rank_costs_[i - own.begin] = 0;
   }
 
   // DFSPH on ranks: the local set, its keys and a pass's output.
@@ -946,6 +967,7 @@ class SphFluid final : public Solver<Real> {
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
 
   double mean_neighbours_ = 0;
+  std::vector<std::uint64_t> rank_costs_;  // on ranks: the own particles' costs (add_rank_costs)
   double neighbour_sum_ = 0;     // Σ of mean_neighbours_ over evaluations (the summary's mean)
   std::uint64_t evaluations_ = 0;
   bool used_grid_ = false;
