@@ -1,6 +1,7 @@
 #include "swirl/sim/run.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -14,6 +15,7 @@
 
 #include <fmt/format.h>
 
+#include "swirl/dist/gather_particles.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/checkpoint.hpp"
 #include "swirl/io/csv.hpp"
@@ -565,6 +567,37 @@ std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<R
                                 summary.warnings.empty() ? "" : " (" + summary.warnings.back() + ")"));
 }
 
+// Rank 0's checkpoint header (step, time) and values on every rank, bit for bit.
+std::pair<io::CheckpointHeader, NamedValues> share_checkpoint_values(
+    const dist::Communicator& comm, const std::pair<io::CheckpointHeader, NamedValues>& mine) {
+  // Lines "name<TAB>bits" (hex, exact), after one for the header.
+  std::string text;
+  if (comm.is_root()) {
+    text = fmt::format("{:x}\t{:x}\n", mine.first.step, std::bit_cast<std::uint64_t>(mine.first.time));
+    for (const auto& [name, value] : mine.second) text += fmt::format("{}\t{:x}\n", name, std::bit_cast<std::uint64_t>(value));
+  }
+  text = comm.first_text(text);
+  if (comm.is_root()) return mine;
+  std::pair<io::CheckpointHeader, NamedValues> out;
+  out.first = mine.first;
+  std::size_t at = 0;
+  bool header = true;
+  while (at < text.size()) {
+    const std::size_t tab = text.find('\t', at), end = text.find('\n', at);
+    const std::string name = text.substr(at, tab - at);
+    const std::uint64_t bits = std::stoull(text.substr(tab + 1, end - tab - 1), nullptr, 16);
+    if (header) {
+      out.first.step = std::stoull(name, nullptr, 16);
+      out.first.time = std::bit_cast<double>(bits);
+      header = false;
+    } else {
+      out.second.emplace_back(name, std::bit_cast<double>(bits));
+    }
+    at = end + 1;
+  }
+  return out;
+}
+
 // What stopped a stage of the loop: a blow-up, a failed write; empty: nothing.
 struct Failure {
   std::string error;
@@ -595,22 +628,44 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   const dist::Communicator& comm = options.ranks ? *options.ranks : dist::Communicator::world();
   const bool on_ranks = options.ranks && options.ranks->distributed();
   const bool root = !on_ranks || comm.is_root();
-  Simulation<Real> sim = build_simulation<Real>(scene);
   if (on_ranks) {
-    if (const std::string no = distributed_support(scene, sim.particles()); !no.empty())
+    if (const std::string no = distributed_support(scene); !no.empty())
       throw std::invalid_argument(fmt::format("{}: {} does not run on several MPI ranks yet ({} ranks were started); "
                                               "run it on one (docs/design/mpi.md says what is distributed so far)",
                                               scene.file, no, comm.size()));
     if (options.extend_float || options.extend_double)
       throw std::invalid_argument("solvers and observers added from Python do not run on several MPI ranks");
-    if (sim.particles().size() < static_cast<std::size_t>(comm.size()))
+  }
+  // On several ranks rank 0 alone builds the particles (the peak memory is one
+  // set, not one per rank) and sends each rank its share at start; its
+  // refusal of the scene is every rank's.
+  ParticleSet<Real> built;
+  if (root) {
+    if (!on_ranks) {
+      built = scene::make_particles<Real>(scene);
+    } else {
+      std::string refused;
+      try {
+        built = scene::make_particles<Real>(scene);
+      } catch (const std::exception& e) {  // a scene's or a file's refusal: bad input on every rank
+        refused = e.what();
+      }
+      if (!comm.first_text(refused).empty()) throw std::invalid_argument(refused);
+    }
+  } else if (const std::string refused = comm.first_text({}); !refused.empty()) {
+    throw std::invalid_argument(refused);
+  }
+  const std::uint64_t particle_count = on_ranks ? comm.sum(std::uint64_t(built.size())) : built.size();
+  if (on_ranks) {
+    dist::share_layout_from_root(comm, built);
+    if (particle_count < static_cast<std::uint64_t>(comm.size()))
       throw std::invalid_argument(fmt::format("{}: {} particles on {} MPI ranks: every rank needs at least one "
                                               "particle; run on at most {} rank{}",
-                                              scene.file, sim.particles().size(), comm.size(),
-                                              std::max<std::size_t>(sim.particles().size(), 1),
-                                              sim.particles().size() > 1 ? "s" : ""));
-    sim.distribute(comm);
+                                              scene.file, particle_count, comm.size(),
+                                              std::max<std::uint64_t>(particle_count, 1), particle_count > 1 ? "s" : ""));
   }
+  Simulation<Real> sim = build_simulation<Real>(scene, std::move(built));
+  if (on_ranks) sim.distribute(comm, /*whole_on_root=*/true);
   std::vector<std::shared_ptr<Observer<Real>>> added;
   if constexpr (std::is_same_v<Real, float>) {
     if (options.extend_float) added = options.extend_float(sim);
@@ -656,7 +711,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   }
   sim.set_on_blow_up(options.on_blow_up);
   sim.prepare();  // every field declared, so a checkpoint's fields meet their uses
-  summary.particles = sim.particles().size();  // on ranks: still the whole set (distribute() keeps it until start)
+  summary.particles = particle_count;
 
   // Where the run ends (RunEnd): decided once the clock is known (below).
   const bool adaptive = scene.adaptive_dt;
@@ -695,10 +750,11 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     std::pair<io::CheckpointHeader, NamedValues> read;
     on_root([&] { read = read_newest_checkpoint(sim, *folder, hash, summary); });
     if (on_ranks) {
-      // The checkpoint rank 0 chose, read whole by every other rank (resume() keeps its share).
-      const std::filesystem::path file = comm.first_text(root ? summary.last_checkpoint.string() : std::string());
-      if (!root) read.first = io::read_checkpoint(file, sim.particles(), read.second);
-      summary.last_checkpoint = file;
+      // Rank 0 read the checkpoint whole; the others get its fields, its clock
+      // and the states (resume() sends each rank its particles).
+      summary.last_checkpoint = comm.first_text(root ? summary.last_checkpoint.string() : std::string());
+      dist::share_layout_from_root(comm, sim.particles());
+      read = share_checkpoint_values(comm, read);
     }
     const auto& [header, values] = read;
     SimulationClock clock{header.step, header.time, find_value(values, "clock.previous_dt").value_or(0),
@@ -799,9 +855,9 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   return summary;
 }
 
-// What of a scene (built: its particles) does not run on several ranks yet.
+// What of a scene does not run on several ranks yet (its solvers as its precision makes them).
 template <class Real>
-std::string distributed_support_of(const scene::Scene& scene, const ParticleSet<Real>& /*particles*/) {
+std::string distributed_support_of(const scene::Scene& scene) {
   if (scene.nbody) {
     if (scene.time_steps == scene::TimeSteps::Block) return "simulation.time_steps = \"block\"";
     const std::string no = gravity::GravityForce<Real>(*scene.nbody).distributed_support();
@@ -866,11 +922,9 @@ std::uint64_t memory_available() {
 
 }  // namespace
 
-std::string distributed_support(const scene::Scene& scene, const ParticleSet<float>& particles) {
-  return distributed_support_of(scene, particles);
-}
-std::string distributed_support(const scene::Scene& scene, const ParticleSet<double>& particles) {
-  return distributed_support_of(scene, particles);
+std::string distributed_support(const scene::Scene& scene) {
+  return scene.precision == scene::Precision::Float ? distributed_support_of<float>(scene)
+                                                    : distributed_support_of<double>(scene);
 }
 
 void check_memory(const scene::Scene& scene) {

@@ -28,8 +28,9 @@
 // read in the new one (the frame follows the global box): still a valid
 // partition, whose imbalance is measured before it is kept.
 //
-// adopt(): a run's ranks each build (or read from a checkpoint) the whole
-// set, and each keeps its share: an even slice of the memory order, or, for a
+// adopt(): rank 0 builds (or reads from a checkpoint) the whole set and sends
+// each rank its share (or every rank holds the whole set and keeps its share):
+// an even slice of the memory order, or, for a
 // checkpoint of a skin run whose reference positions are in sorted order, a
 // slice whose ends fall between different keys, so that the kept order is
 // valid at once and the next update() decides as the uninterrupted run would.
@@ -41,9 +42,11 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <span>
@@ -94,49 +97,56 @@ class RankOrder {
     rebalance_threshold_ = threshold;
   }
 
-  // p holds every particle, the same on every rank, in the one-rank memory
-  // order (a scene's initial state, or a checkpoint's when resumed): keeps
-  // this rank's share (see the header).
-  void adopt(ParticleSet<Real>& p, bool resumed) {
-    const std::size_t n = p.size();
+  // p holds every particle in the one-rank memory order (a scene's initial
+  // state, or a checkpoint's when resumed) — on every rank alike, or, with
+  // whole_on_root, on rank 0 alone (the others' p without particles, with the
+  // same fields: dist::share_layout_from_root), which sends each rank its
+  // share: keeps this rank's share (see the header).
+  void adopt(ParticleSet<Real>& p, bool resumed, bool whole_on_root = false) {
     const auto ranks = static_cast<std::size_t>(comm_->size()), r = static_cast<std::size_t>(comm_->rank());
-    global_count_ = n;
     valid_ = false;
     balanced_ = false;
     keys_.clear();
-    cut_keys_.assign(ranks - 1, 0);
     ++epoch_;
-    std::vector<std::size_t> start(ranks + 1, n);
-    for (std::size_t k = 0; k < ranks; ++k) start[k] = n * k / ranks;
-    const std::size_t ref = p.find_field(spatial::ParticleOrder<Real>::kReferenceField);
-    if (resumed && active() && request_.keep_within > 0 && ref != ParticleSet<Real>::npos) {
-      // The one-rank resume's keys: the reference positions' frame (ParticleOrder::resume).
+    // The plan every rank follows, made from the whole set: the count, the
+    // slices' starts, the cuts, and for a skin run's sorted checkpoint the key
+    // frame's box (bits of doubles).
+    std::vector<std::uint64_t> plan;
+    if (!whole_on_root || comm_->is_root()) plan = adoption_plan(p, resumed);
+    if (whole_on_root && comm_->distributed()) {
+      Bytes mine;
+      if (comm_->is_root()) {
+        mine.resize(plan.size() * sizeof(std::uint64_t));
+        std::memcpy(mine.data(), plan.data(), mine.size());
+      }
+      const Bytes root = comm_->all_gather(mine)[0];
+      plan.resize(root.size() / sizeof(std::uint64_t));
+      std::memcpy(plan.data(), root.data(), root.size());
+    }
+    const std::size_t n = plan[0];
+    const bool sorted_keys = plan[1] != 0;
+    const std::vector<std::size_t> start(plan.begin() + 2, plan.begin() + 2 + static_cast<std::ptrdiff_t>(ranks + 1));
+    cut_keys_.assign(plan.begin() + 3 + static_cast<std::ptrdiff_t>(ranks), plan.begin() + 2 + static_cast<std::ptrdiff_t>(2 * ranks));
+    global_count_ = n;
+    first_ = start[r];
+    if (whole_on_root) scatter_from_root(*comm_, p, start);
+    else keep_range(p, start[r], start[r + 1]);
+    if (sorted_keys) {
       std::array<double, 3> lo{}, hi{};
-      for (int a = 0; a < 3; ++a) {
-        const auto& v = p.extra(ref, a);
-        const auto [mn, mx] = std::minmax_element(v.begin(), v.end());
-        if (n > 0) lo[static_cast<std::size_t>(a)] = double(*mn), hi[static_cast<std::size_t>(a)] = double(*mx);
+      for (std::size_t a = 0; a < 3; ++a) {
+        lo[a] = std::bit_cast<double>(plan[2 * ranks + 2 + a]);
+        hi[a] = std::bit_cast<double>(plan[2 * ranks + 5 + a]);
       }
       bool fits = false;
       frame_ = spatial::ParticleOrder<Real>::frame_for(request_, lo, hi, fits);
       cells_fit_ = fits;
-      std::vector<std::uint64_t> all(n);
-      for (std::size_t i = 0; i < n; ++i)
-        all[i] = spatial::ParticleOrder<Real>::key_of(frame_, double(p.extra(ref, 0)[i]), double(p.extra(ref, 1)[i]),
-                                                      double(p.extra(ref, 2)[i]));
-      if (std::is_sorted(all.begin(), all.end())) {
-        // Slice ends at the first particle of a key, and the cuts at those keys.
-        for (std::size_t k = 1; k < ranks; ++k) {
-          if (start[k] < n) start[k] = static_cast<std::size_t>(std::lower_bound(all.begin(), all.end(), all[start[k]]) - all.begin());
-          start[k] = std::max(start[k], start[k - 1]);
-          cut_keys_[k - 1] = start[k] < n ? all[start[k]] : std::numeric_limits<std::uint64_t>::max();
-        }
-        keys_.assign(all.begin() + static_cast<std::ptrdiff_t>(start[r]), all.begin() + static_cast<std::ptrdiff_t>(start[r + 1]));
-        valid_ = true;
-      }
+      const std::size_t ref = p.find_field(spatial::ParticleOrder<Real>::kReferenceField);
+      keys_.resize(p.size());
+      for (std::size_t i = 0; i < p.size(); ++i)
+        keys_[i] = spatial::ParticleOrder<Real>::key_of(frame_, double(p.extra(ref, 0)[i]), double(p.extra(ref, 1)[i]),
+                                                        double(p.extra(ref, 2)[i]));
+      valid_ = true;
     }
-    first_ = start[r];
-    keep_range(p, start[r], start[r + 1]);
   }
 
   // Brings the particles into the global order when the request needs it
@@ -199,6 +209,51 @@ class RankOrder {
   }
 
  private:
+  // adopt()'s plan from the whole set p: {count, sorted keys (0/1), the
+  // ranks' starts (size + 1), the cuts (size − 1), the frame box lo[3], hi[3]
+  // as bits}. An even slice of the memory order each; for a skin run's
+  // checkpoint whose reference positions are in sorted order, slices whose
+  // ends fall between different keys, the cuts at those keys.
+  std::vector<std::uint64_t> adoption_plan(const ParticleSet<Real>& p, bool resumed) const {
+    const std::size_t n = p.size();
+    const auto ranks = static_cast<std::size_t>(comm_->size());
+    std::vector<std::size_t> start(ranks + 1, n);
+    for (std::size_t k = 0; k < ranks; ++k) start[k] = n * k / ranks;
+    std::vector<std::uint64_t> cuts(ranks - 1, 0);
+    std::array<double, 3> lo{}, hi{};
+    bool sorted_keys = false;
+    const std::size_t ref = p.find_field(spatial::ParticleOrder<Real>::kReferenceField);
+    if (resumed && active() && request_.keep_within > 0 && ref != ParticleSet<Real>::npos) {
+      // The one-rank resume's keys: the reference positions' frame (ParticleOrder::resume).
+      for (int a = 0; a < 3; ++a) {
+        const auto& v = p.extra(ref, a);
+        const auto [mn, mx] = std::minmax_element(v.begin(), v.end());
+        if (n > 0) lo[static_cast<std::size_t>(a)] = double(*mn), hi[static_cast<std::size_t>(a)] = double(*mx);
+      }
+      bool fits = false;
+      const spatial::KeyFrame frame = spatial::ParticleOrder<Real>::frame_for(request_, lo, hi, fits);
+      std::vector<std::uint64_t> all(n);
+      for (std::size_t i = 0; i < n; ++i)
+        all[i] = spatial::ParticleOrder<Real>::key_of(frame, double(p.extra(ref, 0)[i]), double(p.extra(ref, 1)[i]),
+                                                      double(p.extra(ref, 2)[i]));
+      if (std::is_sorted(all.begin(), all.end())) {
+        // Slice ends at the first particle of a key, and the cuts at those keys.
+        for (std::size_t k = 1; k < ranks; ++k) {
+          if (start[k] < n) start[k] = static_cast<std::size_t>(std::lower_bound(all.begin(), all.end(), all[start[k]]) - all.begin());
+          start[k] = std::max(start[k], start[k - 1]);
+          cuts[k - 1] = start[k] < n ? all[start[k]] : std::numeric_limits<std::uint64_t>::max();
+        }
+        sorted_keys = true;
+      }
+    }
+    std::vector<std::uint64_t> plan{n, sorted_keys ? 1u : 0u};
+    plan.insert(plan.end(), start.begin(), start.end());
+    plan.insert(plan.end(), cuts.begin(), cuts.end());
+    for (const double v : lo) plan.push_back(std::bit_cast<std::uint64_t>(v));
+    for (const double v : hi) plan.push_back(std::bit_cast<std::uint64_t>(v));
+    return plan;
+  }
+
   void remember(ParticleSet<Real>& p, std::size_t /*block_size*/) {
     const std::size_t ref = p.add_field(std::string(spatial::ParticleOrder<Real>::kReferenceField), 3, FieldUse::Internal);
     for (int a = 0; a < 3; ++a) std::copy(p.position[a].begin(), p.position[a].end(), p.extra(ref, a).begin());

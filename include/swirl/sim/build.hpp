@@ -24,8 +24,10 @@
 
 namespace swirl::sim {
 
+// The scene's simulation with these particles (its own: scene::make_particles;
+// none on the MPI ranks other than 0, which receive their share at start).
 template <class Real>
-Simulation<Real> build_simulation(const scene::Scene& scene) {
+Simulation<Real> build_simulation(const scene::Scene& scene, ParticleSet<Real> particles) {
   SimulationSettings settings;
   settings.dt = scene.dt;
   settings.block_size = scene.block_size;
@@ -58,7 +60,7 @@ Simulation<Real> build_simulation(const scene::Scene& scene) {
         integrate::BlockStepOptions{scene.eta, scene.nbody->softening, int(scene.max_bin)});
   else
     stepper = std::make_unique<integrate::KickDriftStepper<Real>>(integrate::Method::VelocityVerlet, std::move(box));
-  Simulation<Real> sim(scene::make_particles<Real>(scene), settings, std::move(stepper));
+  Simulation<Real> sim(std::move(particles), settings, std::move(stepper));
   if (fluid) sim.add_solver(std::move(fluid));
   if (scene.nbody)
     sim.add_solver(std::make_unique<gravity::GravityForce<Real>>(
@@ -66,6 +68,11 @@ Simulation<Real> build_simulation(const scene::Scene& scene) {
   if (!(scene.gravity == Vec3d{})) sim.add_solver(std::make_unique<UniformGravity<Real>>(scene.gravity.template cast<Real>()));
   if (scene.damping > 0) sim.add_solver(std::make_unique<Damping<Real>>(scene.damping));
   return sim;
+}
+
+template <class Real>
+Simulation<Real> build_simulation(const scene::Scene& scene) {
+  return build_simulation<Real>(scene, scene::make_particles<Real>(scene));
 }
 
 }  // namespace swirl::sim

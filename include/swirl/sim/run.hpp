@@ -160,9 +160,8 @@ struct RunSummary {
 };
 
 // What of a scene does not run on several ranks yet ("self-gravity
-// ([nbody])", ...), given its built particles; empty when all of it does.
-std::string distributed_support(const scene::Scene& scene, const ParticleSet<float>& particles);
-std::string distributed_support(const scene::Scene& scene, const ParticleSet<double>& particles);
+// ([nbody])", ...); empty when all of it does.
+std::string distributed_support(const scene::Scene& scene);
 
 // Refuses, before anything is allocated, a scene whose particles would not fit
 // in the free memory (std::invalid_argument with the estimate and the limit).

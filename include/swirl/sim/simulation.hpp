@@ -33,8 +33,9 @@
 // orbits' energy errors can drift instead of staying bounded; gravity runs that
 // need a bounded error keep a fixed Δt (docs/stability.md).
 //
-// Several ranks (distribute(), issue 19; docs/design/mpi.md): every rank
-// builds (or reads) the whole set, then keeps its range of the global order
+// Several ranks (distribute(), issue 19; docs/design/mpi.md): rank 0 builds
+// (or reads) the whole set and sends each rank its range of the global order
+// (or every rank holds the whole set and keeps its range)
 // (dist/rank_order.hpp) and steps only its own particles; the solvers get the
 // rank order in their context in place of the one-rank order (SPH exchanges
 // ghosts). Whatever decides the run's course is global and exact: the scan is
@@ -131,9 +132,13 @@ class Simulation {
 
   // Runs on the ranks of comm (a no-op on one rank): call before start() or
   // resume(), with the whole set in particles() on every rank; start() or
-  // resume() then keeps this rank's share (see the header).
-  void distribute(const dist::Communicator& comm) {
+  // resume() then keeps this rank's share (see the header). With
+  // whole_on_root: only rank 0's particles() hold the set; the others' none,
+  // with the same fields (dist::share_layout_from_root); start() or resume()
+  // then sends each rank its share.
+  void distribute(const dist::Communicator& comm, bool whole_on_root = false) {
     if (started_) throw std::logic_error("Simulation::distribute() after start()");
+    whole_on_root_ = whole_on_root;
     if (comm.distributed()) {
       ranks_ = std::make_unique<dist::RankOrder<Real>>(comm);
       ranks_->set_rebalance_threshold(settings_.rebalance_threshold);
@@ -201,7 +206,7 @@ class Simulation {
   // Computes a₀ = F(x₀) (and whatever the stepper keeps). Call once before the first step().
   void start() {
     prepare();
-    if (ranks_) ranks_->adopt(particles_, false);
+    if (ranks_) ranks_->adopt(particles_, false, whole_on_root_);
     Evaluation forces(*this);
     stepper_->start(particles_, forces, time(), settings_.block_size);
     rescan();
@@ -229,7 +234,7 @@ class Simulation {
     stepper_->load_state(state);
     for (auto& s : solvers_) s->load_state(state);
     if (ranks_)
-      ranks_->adopt(particles_, true);
+      ranks_->adopt(particles_, true, whole_on_root_);
     else
       order_.resume(particles_, settings_.block_size);
     rescan();  // the limits are a function of the restored fields: the same as before the stop
@@ -609,6 +614,7 @@ class Simulation {
   spatial::ParticleOrder<Real> order_;
   std::unique_ptr<dist::RankOrder<Real>> ranks_;  // several ranks: the global order (order_ unused)
   std::uint64_t evaluations_on_ranks_ = 0;
+  bool whole_on_root_ = false;  // distribute(): the set on rank 0 alone until start() or resume()
   mutable ParticleSet<Real> gathered_;  // whole_particles() on ranks (filled on rank 0)
   mutable std::pair<std::uint64_t, std::uint64_t> gathered_stamp_{};  // the step and epoch it was gathered at
   mutable bool gathered_valid_ = false;
