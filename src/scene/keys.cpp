@@ -272,7 +272,9 @@ std::vector<SceneKey> declare_scene_keys() {
   add(field(SceneKey{.key = "simulation.rebalance_threshold", .section = "simulation", .unit = "–", .range = kAtLeastOne,
                      .doc = "on several MPI ranks: the ranks' key ranges are cut anew when the largest rank's work "
                             "(1 per particle plus its neighbour candidates or interaction-list entries in the last "
-                            "step) over the mean passes this; 1 = at every sort. Changes no result, only the balance"},
+                            "step) over the mean passes this; 1 = at every sort. Changes no result, only the balance",
+                     // The trajectory does not depend on it: not in the checkpoints' scene hash.
+                     .hashed = false},
             in_scene(&Scene::rebalance_threshold)));
   SceneKey dt_max{.key = "simulation.dt_max", .section = "simulation", .type = KeyType::Number, .unit = "s",
                   .range = kPositive,
