@@ -5,17 +5,19 @@ thesis's solver (wcsph) and SPlisHSPlasH's DFSPH on the same dam break
 threads.
 
     /usr/bin/python3 tools/bench_dfsph.py --out /tmp/dfsph-bench \
-        --sizes 1e5 --until 0.1 --repeats 3
+        --sizes 1e5 --until 0.1 --repeats 2
     /usr/bin/python3 tools/bench_dfsph.py --out /tmp/dfsph-bench \
-        --sizes 1e6 --until 0.02 --repeats 2
+        --sizes 1e6 --until 0.01 --repeats 2
+    /usr/bin/python3 tools/bench_dfsph.py --out /tmp/dfsph-bench --table-only
 
 The peer needs a venv with the pysplishsplash wheel (tools/bench_dfsph_peer.py
 says how); --peer-python names its python (or --no-peer).
 
 Per run: the wall time of the steps (swirl: the run's wall time less its
 frame writing, its start()'s first evaluation included; the peer: its
-stepping loop), the process's CPU time (all threads; swirl's includes the
-frames, the peer's excludes its scene loading), steps, simulated time, the
+stepping loop), the CPU time of the steps (all threads; swirl's process less
+that of a run which only starts and writes the same two frames, the peer's
+stepping loop), steps, simulated time, the
 solves' iterations per step, the average compression
 mean(max(ρ − ρ0, 0))/ρ0 of the fluid at the end (and for DFSPH the solver's
 own figures), and the load average (`uptime`) before and after. Nothing here
@@ -105,6 +107,24 @@ def initial_frame(args, size: str) -> Path:
     return frame
 
 
+def frames_cpu(args, size: str) -> float:
+    """CPU seconds of a swirl run that only starts and writes its two CSV frames (one 10 µs
+    step): what swirl's CPU time carries besides its steps. Measured once per size."""
+    cached = args.out / f"frames_cpu_{size}.json"
+    if cached.exists():
+        return json.loads(cached.read_text())["cpu_seconds"]
+    out = args.out / f"frames_cpu_{size}"
+    cmd = [str(args.swirl), "run", str(SCENE), "--threads", str(args.threads), "--steps", "1", "--out", str(out),
+           "--overwrite", "--set", "simulation.dt_max=1e-5", "--set", 'output.format="csv"'] + size_flags(size)
+    rc, wall, cpu = run_child(cmd, dict(os.environ, OMP_NUM_THREADS=str(args.threads)), args.out / f"frames_cpu_{size}.log")
+    if rc != 0:
+        raise SystemExit(f"{' '.join(cmd)} failed ({rc})")
+    for f in out.glob("particles_*.csv"):
+        f.unlink()
+    cached.write_text(json.dumps({"cpu_seconds": cpu, "wall_seconds": wall, "load": load()}) + "\n")
+    return cpu
+
+
 def run_swirl(args, size: str, method: str, rep: int) -> dict:
     out = args.out / f"swirl_{method}_{size}_{rep}"
     summary = args.out / f"swirl_{method}_{size}_{rep}.json"
@@ -140,7 +160,8 @@ def run_peer(args, size: str, rep: int, frame: Path) -> dict:
     out = args.out / f"peer_{size}_{rep}"
     result = args.out / f"peer_{size}_{rep}.json"
     cmd = [str(args.peer_python), str(ROOT / "tools/bench_dfsph_peer.py"), "--frame", str(frame),
-           "--spacing", str(SIZES[size][0]), "--until", str(args.until), "--out", str(out), "--json", str(result)]
+           "--spacing", str(SIZES[size][0]), "--until", str(args.until), "--out", str(out), "--json", str(result),
+           "--walls", args.peer_walls]
     env = dict(os.environ, OMP_NUM_THREADS=str(args.threads))
     load_before = load()
     rc, wall, cpu = run_child(cmd, env, args.out / f"peer_{size}_{rep}.log")
@@ -150,9 +171,29 @@ def run_peer(args, size: str, rep: int, frame: Path) -> dict:
     r = json.loads(result.read_text())
     for name in ("fluid.geo", "walls.geo"):
         (out / name).unlink(missing_ok=True)
-    r.update({"code": "SPlisHSPlasH dfsph", "size": size, "rep": rep, "process_wall": wall, "cpu_seconds": cpu,
+    r.update({"code": peer_label(r), "size": size, "rep": rep, "process_wall": wall, "cpu_seconds": cpu,
               "load_before": load_before, "load_after": load_after})
     return r
+
+
+PEER = "SPlisHSPlasH dfsph"
+PEER_SWIRL_WALLS = "SPlisHSPlasH dfsph, swirl's walls"
+
+
+def peer_label(r: dict) -> str:
+    # Results from before the peer sampled its own walls carry no "walls": they had swirl's.
+    return PEER_SWIRL_WALLS if r.get("walls", "swirl's particles") == "swirl's particles" else PEER
+
+
+FRAMES_CPU: dict = {}
+
+
+def stepping_cpu(r: dict) -> float:
+    """CPU seconds of the steps: the peer's loop as it measured it (older results: the whole
+    process); swirl's process less a run that only starts and writes its two frames."""
+    if r["code"].startswith(PEER):
+        return r.get("cpu_seconds_in_process", r["cpu_seconds"])
+    return r["cpu_seconds"] - FRAMES_CPU.get(r["size"], 0.0)
 
 
 def median(rows, key):
@@ -166,15 +207,17 @@ def table(results: list[dict]) -> str:
              "load (before–after) |", "|" + "---|" * 13]
     by = {}
     for r in results:
+        if r["code"].startswith(PEER):
+            r["code"] = peer_label(r)
         by.setdefault((r["size"], r["code"]), []).append(r)
     for (size, code), rows in sorted(by.items()):
         per_sim = [r["wall_seconds"] / r["sim_time"] for r in rows]
-        cpu_sim = [r["cpu_seconds"] / r["sim_time"] for r in rows]
+        cpu_sim = [stepping_cpu(r) / r["sim_time"] for r in rows]
         per_step = [r["wall_seconds"] / r["steps"] for r in rows]
-        if code == "SPlisHSPlasH dfsph":
+        if code.startswith(PEER):
             it = median(rows, "mean_density_iterations")
             itv = median(rows, "mean_divergence_iterations")
-            boundary = rows[0]["boundary_particles"]
+            boundary = rows[0].get("boundary_particles")
         else:
             it = median(rows, "dfsph_mean_density_iterations")
             itv = median(rows, "dfsph_mean_divergence_iterations")
@@ -189,12 +232,12 @@ def table(results: list[dict]) -> str:
     lines.append("")
     for size in sorted({r["size"] for r in results}):
         med = {}
-        for code in ("swirl dfsph", "swirl wcsph", "SPlisHSPlasH dfsph"):
+        for code in ("swirl dfsph", "swirl wcsph", PEER, PEER_SWIRL_WALLS):
             rows = by.get((size, code))
             if rows:
                 med[code] = (statistics.median(r["sim_time"] / r["wall_seconds"] for r in rows),
-                             statistics.median(r["sim_time"] / r["cpu_seconds"] for r in rows))
-        for a, b in (("swirl dfsph", "SPlisHSPlasH dfsph"), ("swirl dfsph", "swirl wcsph")):
+                             statistics.median(r["sim_time"] / stepping_cpu(r) for r in rows))
+        for a, b in (("swirl dfsph", PEER), ("swirl dfsph", PEER_SWIRL_WALLS), ("swirl dfsph", "swirl wcsph")):
             if a in med and b in med:
                 lines.append(f"- {size}: simulated seconds per wall second, {a} / {b} = "
                              f"{med[a][0] / med[b][0]:.2f} (per CPU second: {med[a][1] / med[b][1]:.2f})")
@@ -213,12 +256,15 @@ def main() -> int:
     ap.add_argument("--swirl", type=Path, default=ROOT / "build/swirl")
     ap.add_argument("--peer-python", type=Path, default=Path("/tmp/dfsphbench-venv/bin/python"))
     ap.add_argument("--keep", action="store_true", help="keep the last CSV frame of each swirl run")
+    ap.add_argument("--peer-walls", default="akinci", choices=("akinci", "swirl"),
+                    help="the peer's walls (tools/bench_dfsph_peer.py --walls)")
+    ap.add_argument("--table-only", action="store_true", help="run nothing: tabulate OUT/results.json")
     args = ap.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
     results_file = args.out / "results.json"
     results = json.loads(results_file.read_text()) if results_file.exists() else []
-    codes = args.codes.split(",")
-    for size in args.sizes.split(","):
+    codes = [] if args.table_only else args.codes.split(",")
+    for size in args.sizes.split(",") if codes else []:
         frame = initial_frame(args, size)
         for rep in range(args.first_rep, args.first_rep + args.repeats):
             for code in codes:
@@ -231,6 +277,8 @@ def main() -> int:
                 results_file.write_text(json.dumps(results, indent=1) + "\n")
                 print(f"    {r['steps']} steps, {r['wall_seconds']:.1f} s wall, {r['cpu_seconds']:.1f} s CPU, "
                       f"final compression {100 * r['final_compression']:.4f} %", flush=True)
+    for size in sorted({r["size"] for r in results}):
+        FRAMES_CPU[size] = frames_cpu(args, size)
     (args.out / "results.md").write_text(table(results))
     print(table(results))
     return 0
