@@ -1,9 +1,12 @@
 // Loading valid scenes: values, defaults, files, the example, scene_hash.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <variant>
+#include <vector>
 
 #include "scene/scene_test_util.hpp"
 #include "swirl/scene/initial_conditions.hpp"
@@ -196,6 +199,34 @@ TEST_F(LoadFile, BadScenesWriteNoFiles) {
   auto after = listing();
   std::erase(after, (dir_ / "syntax.toml").string());
   EXPECT_EQ(before, after);
+}
+
+// The DFSPH benchmark's scene (docs/performance/dfsph.md, tools/bench_dfsph.py)
+// loads as the script runs it: both methods, both sizes, with the documented
+// lattices (40 x 60 x 50 and 80 x 120 x 100 fluid particles) and h = 2 spacings.
+TEST(DfsphBenchScene, LoadsAsTheBenchmarkRunsIt) {
+  const auto file = std::filesystem::path(SWIRL_SOURCE_DIR) / "bench" / "dfsph" / "dam_break.toml";
+  struct Size {
+    std::string spacing, h;
+    double s;
+    std::array<double, 3> cells;
+  };
+  for (const Size& size : {Size{"0.008", "0.016", 0.008, {40, 60, 50}}, Size{"0.004", "0.008", 0.004, {80, 120, 100}}})
+    for (const std::string method : {"dfsph", "wcsph"}) {
+      SCOPED_TRACE(method + " at " + size.spacing);
+      const std::vector<std::string> sets{"particles.0.spacing=" + size.spacing, "sph.smoothing_length=" + size.h,
+                                          "sph.method=\"" + method + "\"", "output.format=\"csv\""};
+      const Scene s = load_scene(file, sets);
+      ASSERT_TRUE(s.sph.has_value());
+      EXPECT_EQ(s.sph->method, method == "dfsph" ? sph::SphMethod::Dfsph : sph::SphMethod::Wcsph);
+      EXPECT_EQ(s.sph->smoothing_length, 2 * size.s);
+      EXPECT_TRUE(s.has_boundary_particles());
+      ASSERT_EQ(s.sources.size(), 1u);
+      const auto& block = std::get<LatticeSource>(s.sources[0]);
+      EXPECT_EQ(block.spacing, size.s);
+      for (int axis = 0; axis < 3; ++axis)
+        EXPECT_NEAR((block.region.hi[axis] - block.region.lo[axis]) / size.s, size.cells[std::size_t(axis)], 1e-9);
+    }
 }
 
 TEST(FallingBlockExample, LoadsAsTheDocumentedDemo) {
