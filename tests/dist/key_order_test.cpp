@@ -13,6 +13,7 @@
 #include <numeric>
 #include <vector>
 
+#include "dist/lattice_block.hpp"
 #include "swirl/dist/key_cuts.hpp"
 
 namespace swirl::dist {
@@ -21,13 +22,7 @@ namespace {
 constexpr std::uint64_t kParticles = 3000;
 
 // A position in [0,1)^3 for global particle g (the same on every rank).
-double coordinate(std::uint64_t g, int axis) {
-  std::uint64_t x = (g + 1) * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(axis) * 0xBF58476D1CE4E5B9ull;
-  x ^= x >> 31;
-  x *= 0x94D049BB133111EBull;
-  x ^= x >> 29;
-  return static_cast<double>(x >> 11) * 0x1.0p-53;
-}
+double coordinate(std::uint64_t g, int axis) { return test::unit_hash(g, static_cast<std::uint64_t>(axis)); }
 
 // A coarse key (8 cells per axis, Morton-interleaved, in the top bits of a
 // 63-bit key): many particles share a key, so the tie order is tested.

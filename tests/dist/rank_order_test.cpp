@@ -12,19 +12,15 @@
 #include <span>
 #include <vector>
 
+#include "dist/lattice_block.hpp"
+
 namespace swirl::dist {
 namespace {
 
 constexpr std::size_t kParticles = 4000;
 
-// Particle g of the whole set at a pseudo-random place in [0,1)^3 (the same on every rank).
-double coordinate(std::uint64_t g, int axis) {
-  std::uint64_t x = (g + 1) * 0x9E3779B97F4A7C15ull + static_cast<std::uint64_t>(axis) * 0xBF58476D1CE4E5B9ull;
-  x ^= x >> 31;
-  x *= 0x94D049BB133111EBull;
-  x ^= x >> 29;
-  return static_cast<double>(x >> 11) * 0x1.0p-53;
-}
+// A position in [0,1)^3 for global particle g (the same on every rank).
+double coordinate(std::uint64_t g, int axis) { return test::unit_hash(g, static_cast<std::uint64_t>(axis)); }
 
 ParticleSet<double> whole_set() {
   ParticleSet<double> p(kParticles);
