@@ -36,8 +36,9 @@
 // reading the others as neighbours (a rank's own particles among its ghosts,
 // dist/halo.hpp); each particle's result is the bits of a pass over all.
 //
-// Scalar loops, one pair at a time (correctness first: the SIMD twins of the
-// thesis's passes, sph/grid_passes.hpp, are the model for faster ones).
+// Scalar loops, one pair at a time. The solves run dfsph_density_change and
+// dfsph_pressure_velocity over the pairs the density pass kept
+// (sph/dfsph_pairs.hpp); the grid versions here are their slow twins.
 // Each pass writes only particle i's entries and gathers over the grid's fixed
 // candidate ranges, so its result is bit-identical for any thread count.
 // Units: SI (ρ in kg/m³, κ in m²/s², α in m⁶·s⁰/kg: ρ/(kg²/m⁸)).
@@ -47,6 +48,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "swirl/core/index_range.hpp"
 #include "swirl/core/particle_kind.hpp"
@@ -54,6 +56,7 @@
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/spatial/cell_grid.hpp"
 #include "swirl/spatial/distance.hpp"
+#include "swirl/sph/dfsph_pairs.hpp"
 #include "swirl/sph/grid_passes.hpp"
 #include "swirl/sph/laws.hpp"
 
@@ -104,25 +107,30 @@ double dfsph_lattice_factor(const DfsphKernel<Real>& kernel, double m, double s)
 
 // ρ into p.density, α into alpha[0, n), α at most alpha_cap; returns the
 // neighbour pairs (self excluded). kind: null, or the particles' kinds (then
-// a boundary particle gets ρ = rest_density and α = 0).
+// a boundary particle gets ρ = rest_density and α = 0). keep: null, or where
+// the pairs found and their m_j ∇W_ij are kept for the solves
+// (sph/dfsph_pairs.hpp).
 template <class Real>
 std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
                                        const DfsphKernel<Real>& kernel, std::size_t block_size, Real* alpha,
                                        Real alpha_cap, const std::int32_t* kind = nullptr, Real rest_density = 0,
-                                       IndexRange only = detail::kAllParticles) {
+                                       IndexRange only = detail::kAllParticles, DfsphPairs<Real>* keep = nullptr) {
   const IndexRange range = detail::pass_range(only, p.size());
   const std::size_t from = range.begin;
   const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
   Real* rho = p.density.data();
+  if (keep) keep->prepare(range, block_size);
   return parallel::reduce_blocks_pinned(
       "dfsph_density", range.end - range.begin, block_size, std::uint64_t{0},
       [&](std::size_t b, std::size_t e) {
         const DfsphKernel<Real> k = kernel;
         std::uint64_t pairs = 0;
+        std::vector<typename DfsphPairs<Real>::Pair>* list = keep ? &keep->start_block(b) : nullptr;
         detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
           if (kind && is_boundary(kind[i])) {
             rho[i] = rest_density;
             alpha[i] = 0;
+            if (list) keep->end_list(i - from, list->size());
             return;
           }
           Real density = 0, gx = 0, gy = 0, gz = 0, g2 = 0;
@@ -134,7 +142,9 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
             const Real g = m[j] * k.gradient(r);  // m_j ∇W_ij = g · r⃗_ij (0 for j = i)
             gx += g * dx, gy += g * dy, gz += g * dz;
             if (!kind || !is_boundary(kind[j])) g2 += g * g * r2;
+            if (list && j != i) list->push_back({static_cast<std::uint32_t>(j), g * dx, g * dy, g * dz});
           });
+          if (list) keep->end_list(i - from, list->size());
           rho[i] = density;
           const Real denominator = gx * gx + gy * gy + gz * gz + g2;
           // The floor: a millionth of one neighbour's |m ∇W|² at the kernel's

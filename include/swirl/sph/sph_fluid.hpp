@@ -247,6 +247,7 @@ class SphFluid final : public Solver<Real> {
   }
 
   // ---- DFSPH (sph/dfsph_stepper.hpp): passes on the last evaluation's grid ----
+  // and on the pairs it kept (sph/dfsph_pairs.hpp: the solves' two passes).
   // Valid between an evaluation and the next position change.
   const DfsphKernel<Real>& dfsph_kernel() const { return *kernel_; }
   // On several ranks (after an evaluation there) p holds this rank's own
@@ -258,25 +259,25 @@ class SphFluid final : public Solver<Real> {
   const Real* factor() const { return alpha_.data() + (ranks_ ? own_.begin : 0); }
   void density_change(const ParticleSet<Real>& p, Real* out, std::size_t block_size) {
     if (!ranks_) {
-      dfsph_density_change(grid_, p, *kernel_, block_size, out, kinds(p));
+      dfsph_density_change(pairs_, p, block_size, out, kinds(p), detail::all_of(p));
       return;
     }
     to_local(p.velocity, local_.velocity);
     halo_.refresh(ranks_->comm(), local_, {"velocity"});
     local_out_.resize(local_.size());
-    dfsph_density_change(grid_, local_, *kernel_, block_size, local_out_.data(), kinds(local_), own_);
+    dfsph_density_change(pairs_, local_, block_size, local_out_.data(), kinds(local_), own_);
     std::copy_n(local_out_.data() + own_.begin, p.size(), out);
   }
   void pressure_velocity(ParticleSet<Real>& p, const Real* k_over_rho, Real dt, std::size_t block_size) {
     if (!ranks_) {
-      dfsph_pressure_velocity(grid_, p, *kernel_, block_size, k_over_rho, dt, kinds(p));
+      dfsph_pressure_velocity(pairs_, p, block_size, k_over_rho, dt, kinds(p), detail::all_of(p));
       return;
     }
     AlignedVector<Real>& kr = local_.extra(kr_field_);
     std::copy_n(k_over_rho, p.size(), kr.data() + own_.begin);
     halo_.refresh(ranks_->comm(), local_, {std::string(kLocalKappaField)});
     to_local(p.velocity, local_.velocity);
-    dfsph_pressure_velocity(grid_, local_, *kernel_, block_size, kr.data(), dt, kinds(local_), own_);
+    dfsph_pressure_velocity(pairs_, local_, block_size, kr.data(), dt, kinds(local_), own_);
     from_local(local_.velocity, p.velocity);
   }
   // The non-pressure force of the fluid: the thesis's viscosity (eq. 2.10).
@@ -518,7 +519,7 @@ class SphFluid final : public Solver<Real> {
   // Bytes the solver keeps between evaluations (search structures, lists,
   // scratch), in all: add to the particle fields for the memory per particle.
   std::size_t scratch_bytes() const override {
-    return grid_.bytes() + scratch_.bytes() + alpha_.capacity() * sizeof(Real) +
+    return grid_.bytes() + scratch_.bytes() + alpha_.capacity() * sizeof(Real) + pairs_.bytes() +
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
            lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
@@ -740,7 +741,7 @@ class SphFluid final : public Solver<Real> {
     {
       PhaseScope phase(ctx, "forces.density");
       pairs = dfsph_density_and_factor(grid_, p, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_), kind,
-                                       Real(params_.rest_density));
+                                       Real(params_.rest_density), detail::kAllParticles, &pairs_);
     }
     const std::size_t fluid = fluid_count(p);  // a boundary particle's own pairs are not summed
     mean_neighbours_ = fluid == 0 ? 0.0 : static_cast<double>(pairs) / static_cast<double>(fluid);
@@ -806,7 +807,7 @@ class SphFluid final : public Solver<Real> {
     {
       PhaseScope phase(ctx, "forces.density");
       pairs = dfsph_density_and_factor(grid_, local_, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_), kind,
-                                       Real(params_.rest_density), own_);
+                                       Real(params_.rest_density), own_, &pairs_);
       std::copy_n(local_.density.data() + own_.begin, n, p.density.data());
       if (params_.viscosity > 0) halo_.refresh(comm, local_, {"density"});  // the viscosity's V_j = m_j/ρ_j
     }
@@ -950,6 +951,7 @@ class SphFluid final : public Solver<Real> {
   GridScratch<Real> scratch_;
   std::optional<DfsphKernel<Real>> kernel_;  // DFSPH: built at the first evaluation
   AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
+  DfsphPairs<Real> pairs_;                   // DFSPH: its pairs with m_j ∇W_ij, for the solves' passes
   AlignedVector<Real> boundary_pressure_;    // thesis's solver: p_b of the last evaluation (scratch)
   std::vector<std::uint64_t> halo_keys_;     // on ranks: the keys of the own particles and their ghosts (scratch)
   const dist::RankOrder<Real>* ranks_ = nullptr;  // the last evaluation's rank order (null: one rank)

@@ -1,0 +1,178 @@
+// The solve passes over the kept pairs (sph/dfsph_pairs.hpp) against their
+// slow twins over the grid (sph/dfsph_passes.hpp), on a jittered block of
+// fluid beside a wall of boundary particles, with random velocities and κ:
+// the same values to rounding, the pairs found equal to the grid's, and the
+// same bits for any thread count and for a pass over a sub-range (a rank's
+// own particles among its ghosts).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "swirl/core/particle_kind.hpp"
+#include "swirl/core/random.hpp"
+#include "swirl/spatial/cell_grid.hpp"
+#include "swirl/spatial/particle_order.hpp"
+#include "swirl/sph/dfsph_pairs.hpp"
+#include "swirl/sph/dfsph_passes.hpp"
+
+namespace {
+
+using namespace swirl;
+
+template <class Real>
+struct Setup {
+  ParticleSet<Real> p;
+  std::vector<Real> kr;  // κ/ρ
+  double h = 0;
+  spatial::ParticleOrder<Real> order;
+  spatial::SortedCellGrid<Real> grid;
+  std::size_t kind_field = 0;
+  const std::int32_t* kind() const { return p.int_field(kind_field).data(); }
+};
+
+// A 12 × 12 × 10 block of fluid at spacing s, jittered by up to s/4, on a
+// floor of boundary particles (one layer at z = 0); h = 2 s.
+template <class Real>
+void make(Setup<Real>& s) {
+  const double sp = 0.01;
+  s.h = 2 * sp;
+  s.kind_field = s.p.add_int_field(std::string(kKindField));
+  SplitMix64 rng(7);
+  auto uniform = [&](double lo, double hi) { return lo + (hi - lo) * rng.uniform(); };
+  std::size_t n = 0;
+  auto add = [&](double x, double y, double z, bool boundary) {
+    s.p.resize(n + 1);
+    s.p.position.set(n, Vec3d{x, y, z}.cast<Real>());
+    s.p.velocity.set(n, boundary ? Vec3<Real>{} : Vec3d{uniform(-1, 1), uniform(-1, 1), uniform(-1, 1)}.cast<Real>());
+    s.p.mass[n] = Real(boundary ? 0.6 : 1.0);
+    s.p.id[n] = n;
+    s.p.int_field(s.kind_field)[n] = boundary ? 1 : 0;
+    ++n;
+  };
+  for (int i = -2; i < 14; ++i)
+    for (int j = -2; j < 14; ++j) add(i * sp, j * sp, 0, true);
+  for (int k = 1; k <= 10; ++k)
+    for (int j = 0; j < 12; ++j)
+      for (int i = 0; i < 12; ++i)
+        add((i + uniform(-0.25, 0.25)) * sp, (j + uniform(-0.25, 0.25)) * sp, (k + uniform(-0.25, 0.25)) * sp,
+            false);
+  spatial::OrderRequest request;
+  request.sorted = true;
+  request.cell_length = s.h;
+  s.order.set_request(request);
+  s.order.update(s.p, 64);
+  ASSERT_TRUE(s.grid.view(s.order, 64));
+  s.kr.resize(s.p.size());
+  for (std::size_t i = 0; i < s.p.size(); ++i) s.kr[i] = is_boundary(s.kind()[i]) ? Real(0) : Real(uniform(0, 2e-3));
+}
+
+template <class F>
+auto with_threads(int n, F&& f) {
+  const int saved = parallel::thread_count();
+  parallel::set_thread_count(n);
+  auto result = f();
+  parallel::set_thread_count(saved);
+  return result;
+}
+
+template <class Real>
+class DfsphPairsTest : public ::testing::Test {};
+using Reals = ::testing::Types<float, double>;
+TYPED_TEST_SUITE(DfsphPairsTest, Reals);
+
+TYPED_TEST(DfsphPairsTest, SolvePassesEqualTheGridPassesToRounding) {
+  using Real = TypeParam;
+  Setup<Real> s;
+  make(s);
+  const std::size_t n = s.p.size(), bs = 64;
+  const sph::DfsphKernel<Real> kernel(sph::SphKernel::CubicSpline, Real(s.h));
+  std::vector<Real> alpha(n), alpha_kept(n);
+  const std::uint64_t found = sph::dfsph_density_and_factor(s.grid, s.p, kernel, bs, alpha.data(), Real(1e30), s.kind(), Real(1000));
+  sph::DfsphPairs<Real> pairs;
+  const std::uint64_t found_kept = sph::dfsph_density_and_factor(s.grid, s.p, kernel, bs, alpha_kept.data(), Real(1e30), s.kind(),
+                                                                 Real(1000), sph::detail::kAllParticles, &pairs);
+  // Keeping the pairs changes nothing the pass computes, and keeps every pair it found.
+  EXPECT_EQ(found, found_kept);
+  EXPECT_EQ(alpha, alpha_kept);
+  EXPECT_EQ(pairs.pairs(), found);  // boundary particles' own pairs are neither counted nor kept
+  ASSERT_GT(found, 30 * 1000u);
+
+  const IndexRange all{0, static_cast<std::uint32_t>(n)};
+  std::vector<Real> slow(n), fast(n);
+  sph::dfsph_density_change(s.grid, s.p, kernel, bs, slow.data(), s.kind());
+  sph::dfsph_density_change(pairs, s.p, bs, fast.data(), s.kind(), all);
+  // Rounding: the sum of |terms| bounds the error of either sum.
+  const double eps = std::is_same_v<Real, float> ? 1e-5 : 1e-13;
+  double scale = 0;
+  for (std::size_t i = 0; i < n; ++i) scale = std::max(scale, std::abs(double(slow[i])));
+  for (std::size_t i = 0; i < n; ++i) {
+    if (is_boundary(s.kind()[i])) {
+      EXPECT_EQ(fast[i], 0) << i;
+      continue;
+    }
+    EXPECT_NEAR(fast[i], slow[i], eps * scale) << i;
+  }
+
+  // The velocity changes of the pressure pass: the same to rounding (of the
+  // changes, and of adding them to velocities of order 1).
+  const ParticleSet<Real> before = s.p;
+  ParticleSet<Real> q = s.p;
+  sph::dfsph_pressure_velocity(s.grid, s.p, kernel, bs, s.kr.data(), Real(1e-3), s.kind());
+  sph::dfsph_pressure_velocity(pairs, q, bs, s.kr.data(), Real(1e-3), s.kind(), all);
+  double largest = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a)
+      largest = std::max(largest, std::abs(double(s.p.velocity[a][i]) - double(before.velocity[a][i])));
+  ASSERT_GT(largest, 1e-2);
+  const double ulp = std::is_same_v<Real, float> ? 2e-7 : 4e-16;
+  for (std::size_t i = 0; i < n; ++i)
+    for (int a = 0; a < 3; ++a) {
+      const double slow_change = double(s.p.velocity[a][i]) - double(before.velocity[a][i]);
+      const double fast_change = double(q.velocity[a][i]) - double(before.velocity[a][i]);
+      EXPECT_NEAR(fast_change, slow_change, eps * largest + 2 * ulp) << i << " " << a;
+    }
+}
+
+TYPED_TEST(DfsphPairsTest, AnyThreadCountAndASubRangeGiveTheSameBits) {
+  using Real = TypeParam;
+  Setup<Real> s;
+  make(s);
+  const std::size_t n = s.p.size(), bs = 64;
+  const sph::DfsphKernel<Real> kernel(sph::SphKernel::CubicSpline, Real(s.h));
+  std::vector<Real> alpha(n);
+  const IndexRange all{0, static_cast<std::uint32_t>(n)};
+  auto run = [&](IndexRange range) {
+    sph::DfsphPairs<Real> pairs;
+    sph::dfsph_density_and_factor(s.grid, s.p, kernel, bs, alpha.data(), Real(1e30), s.kind(), Real(1000), range, &pairs);
+    std::vector<Real> change(n, Real(-1));
+    sph::dfsph_density_change(pairs, s.p, bs, change.data(), s.kind(), range);
+    ParticleSet<Real> q = s.p;
+    sph::dfsph_pressure_velocity(pairs, q, bs, s.kr.data(), Real(1e-3), s.kind(), range);
+    std::vector<Real> v(q.velocity.x.begin(), q.velocity.x.end());
+    v.insert(v.end(), change.begin(), change.end());
+    return v;
+  };
+  const auto one = with_threads(1, [&] { return run(all); });
+  const auto two = with_threads(2, [&] { return run(all); });
+  const auto three = with_threads(3, [&] { return run(all); });
+  EXPECT_EQ(one, two);
+  EXPECT_EQ(one, three);
+  // A sub-range starting off a block boundary: its particles' bits are those of the whole pass.
+  const IndexRange part{100, static_cast<std::uint32_t>(n - 50)};
+  const auto sub = run(part);
+  for (std::size_t i = part.begin; i < part.end; ++i) {
+    EXPECT_EQ(sub[i], one[i]) << i;
+    EXPECT_EQ(sub[n + i], one[n + i]) << i;
+  }
+  // A pass over pairs kept for another range is refused.
+  sph::DfsphPairs<Real> pairs;
+  sph::dfsph_density_and_factor(s.grid, s.p, kernel, bs, alpha.data(), Real(1e30), s.kind(), Real(1000), part, &pairs);
+  std::vector<Real> change(n);
+  EXPECT_THROW(sph::dfsph_density_change(pairs, s.p, bs, change.data(), s.kind(), all), std::logic_error);
+  EXPECT_THROW(sph::dfsph_density_change(pairs, s.p, 32, change.data(), s.kind(), part), std::logic_error);
+}
+
+}  // namespace
