@@ -28,6 +28,7 @@
 #include "swirl/scene/load.hpp"
 #include "swirl/scene/validate.hpp"
 #include "swirl/sim/build.hpp"
+#include "swirl/sim/footprint.hpp"
 #include "swirl/sim/observer.hpp"
 #include "probe_log.hpp"
 
@@ -874,52 +875,6 @@ std::string distributed_support_of(const scene::Scene& scene) {
   return {};
 }
 
-// Memory and disk a scene needs, estimated before anything is allocated.
-struct Footprint {
-  double memory = 0;  // bytes: particle fields, solver scratch, neighbour lists
-  double frame = 0;   // bytes of one .vtp frame
-};
-
-// Every size a scene sets is in it: the particle count, the neighbours its
-// smoothing length gives, the hash table's buckets, a dense cell table's cells.
-Footprint footprint(const scene::Scene& scene) {
-  const double n = static_cast<double>(scene::count_particles(scene));
-  const double real = scene.precision == scene::Precision::Float ? 4 : 8;
-  // 16 reals and an id of fields; the scene's double copy while building; tree
-  // nodes for gravity.
-  double per_particle = 16 * real + 8 + 56;
-  if (scene.nbody) per_particle += 2 * 96;
-  double fixed = 0;
-  if (scene.sph) {
-    const sph::SphParameters& sph = *scene.sph;
-    const double h = sph.smoothing_length;
-    // Neighbours: ~40 at the usual k, more when h is large against the
-    // spacing (from the box's mean density: fluid fills part of it, so at least 40).
-    double neighbours = 40;
-    if (scene.walls) {
-      const Vec3d size = scene.box.hi - scene.box.lo;
-      const double volume = size.x * size.y * size.z;
-      if (volume > 0) neighbours = std::max(neighbours, std::min(n, 4.18879 * h * h * h * n / volume));
-    }
-    // Sorted copies, and (index, r²) per neighbour twice (block lists and the CSR).
-    per_particle += 40 + 2 * neighbours * (4 + real);
-    if (sph.neighbour_search == sph::NeighbourSearch::Hash) {
-      // The counting sort's offsets and one count per bucket for each chunk (thread).
-      const double buckets = sph.buckets ? double(sph.buckets) : 1.6 * n + 1;
-      const double chunks = std::min(double(parallel::thread_count()), std::floor(n / 4096) + 1);
-      fixed += 4 * buckets * (1 + chunks);
-    } else {
-      fixed += 4 * scene::dense_cell_table_keys(scene);  // one start per cell key
-    }
-  }
-  return {n * per_particle + fixed, n * (16 * real + 8 + 16) + 4096};
-}
-
-std::uint64_t memory_available() {
-  const long pages = sysconf(_SC_AVPHYS_PAGES), size = sysconf(_SC_PAGESIZE);
-  return pages > 0 && size > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(size) : 0;
-}
-
 }  // namespace
 
 std::string distributed_support(const scene::Scene& scene) {
@@ -927,19 +882,27 @@ std::string distributed_support(const scene::Scene& scene) {
                                                     : distributed_support_of<double>(scene);
 }
 
-void check_memory(const scene::Scene& scene) {
-  const Footprint f = footprint(scene);
-  const std::uint64_t available = memory_available();
-  if (available > 0 && f.memory > 0.9 * static_cast<double>(available))
-    throw std::invalid_argument(fmt::format(
-        "{}: {} particles need about {:.1f} GB of memory, more than the {:.1f} GB this machine has free (counted: "
-        "the particle fields, the neighbour lists the smoothing length gives, sph.hash.buckets, a dense sph.grid.table)",
-        scene.file, scene::count_particles(scene), f.memory / 1e9, static_cast<double>(available) / 1e9));
+void check_memory(const scene::Scene& scene, const dist::Communicator* ranks) {
+  std::vector<RankHost> hosts;
+  if (ranks && ranks->distributed()) {
+    // Where each rank runs and what it sees free: ranks on one host share its memory.
+    char name[256] = {};
+    if (gethostname(name, sizeof name - 1) != 0) name[0] = '\0';
+    const std::string mine = fmt::format("{}\n{}", name, memory_available());
+    dist::Bytes bytes(mine.size());
+    std::memcpy(bytes.data(), mine.data(), mine.size());
+    for (const dist::Bytes& b : ranks->all_gather(bytes)) {
+      const std::string text(reinterpret_cast<const char*>(b.data()), b.size());
+      const auto cut = text.rfind('\n');
+      hosts.push_back({text.substr(0, cut), std::stoull(text.substr(cut + 1))});
+    }
+  }
+  if (const std::string no = memory_refusal(scene, hosts); !no.empty()) throw std::invalid_argument(no);
 }
 
 RunSummary run_scene(const scene::Scene& scene, const RunOptions& options,
                      const std::function<void(const RunProgress&)>& on_progress) {
-  check_memory(scene);
+  check_memory(scene, options.ranks);
   if (options.threads > 0) parallel::set_thread_count(options.threads);
   const auto frame = static_cast<std::uintmax_t>(footprint(scene).frame);
   return scene.precision == scene::Precision::Float ? run_typed<float>(scene, options, frame, on_progress)

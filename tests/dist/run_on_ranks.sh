@@ -163,6 +163,16 @@ on_ranks 2 run "$scene" "${small[@]}" --steps 2 --out "$out/float_1"
 [ "$status" -eq 2 ] || fail "a run into another run's folder on 2 ranks: status $status (want 2)"
 grep -q "swirl: error" "$out/stderr" || fail "a run into another run's folder: no error message"
 
+# 8a. Too big for the hosts' memory: refused once, before anything is
+#     built, with the estimate per rank and the host that is short (all ranks
+#     here share one host and its free memory).
+on_ranks 2 run "$examples/random_box.toml" --set particles=2000000000 --out "$out/huge"
+[ "$status" -eq 2 ] || fail "2e9 particles on 2 ranks: status $status (want 2)"
+[ "$(grep -c '2000000000 particles on 2 MPI ranks need about .* GB of memory on each rank and .* GB on rank 0' "$out/stderr")" -eq 1 ] ||
+  { fail "2e9 particles on 2 ranks: the estimate per rank is not said exactly once"; cat "$out/stderr"; }
+grep -q "GB on host .* for its 2 ranks, more than the" "$out/stderr" || fail "2e9 particles on 2 ranks: the host is not named"
+[ ! -e "$out/huge" ] || fail "2e9 particles on 2 ranks: the refused run created its folder"
+
 # 8. More ranks than particles: said before anything runs, status 2.
 on_ranks 4 run "$scene" --set particles.0.spacing=0.29 --steps 2 --out "$out/few"
 [ "$status" -eq 2 ] || fail "1 particle on 4 ranks: status $status (want 2)"

@@ -164,8 +164,10 @@ struct RunSummary {
 std::string distributed_support(const scene::Scene& scene);
 
 // Refuses, before anything is allocated, a scene whose particles would not fit
-// in the free memory (std::invalid_argument with the estimate and the limit).
-void check_memory(const scene::Scene& scene);
+// in the free memory (std::invalid_argument with the estimate and the limit;
+// sim/footprint.hpp). On several ranks (`ranks` distributed; collective) each
+// rank's share is counted against the memory of the host it runs on.
+void check_memory(const scene::Scene& scene, const dist::Communicator* ranks = nullptr);
 
 // Runs the scene. Before running anything it calls check_memory(), builds the
 // particles, and throws io::IoError if out_dir cannot be written, has no room
