@@ -29,8 +29,14 @@
 
 #include "swirl/core/particle_set.hpp"
 #include "swirl/dist/communicator.hpp"
+#include "swirl/parallel/radix_sort.hpp"
+#include "swirl/spatial/reorder_particles.hpp"
 
 namespace swirl::dist {
+
+// Particles per block of the reorder's parallel gather (scheduling only: any
+// value gives the same bits).
+inline constexpr std::size_t kReorderBlock = 4096;
 
 // The rank whose key range holds key.
 inline int owner_of(std::uint64_t key, std::span<const std::uint64_t> cut_keys) {
@@ -116,15 +122,19 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
       particles.for_each_int_array([&](AlignedVector<Int>& a) { get(at, a[j]); });
     }
   }
-  std::vector<std::size_t> order(count);
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return keys[a] != keys[b] ? keys[a] < keys[b] : previous_index[a] < previous_index[b];
-  });
-  particles.reorder(order);
-  std::vector<std::uint64_t> sorted_keys(count);
-  for (std::size_t i = 0; i < count; ++i) sorted_keys[i] = keys[order[i]];
-  keys.swap(sorted_keys);
+  // Each source rank held a contiguous range of the previous order and sent
+  // its particles in that order, and the sources arrive in rank order: so the
+  // arrival order is the previous global order, and the stable sort by key
+  // (the one-rank radix sort, parallel and linear) is the sort by (key,
+  // previous global index).
+  if (count > 0xffffffffu) throw std::invalid_argument("distribute_in_key_order: more than 2^32 - 1 particles on a rank");
+  for (std::size_t i = 1; i < count; ++i)
+    if (previous_index[i] <= previous_index[i - 1])
+      throw std::logic_error("distribute_in_key_order: the ranks' particles were not in the global order");
+  parallel::RadixSort<std::uint64_t> sorter;
+  sorter.sort(keys, 64);
+  spatial::ParticleReorder<Real>().apply(particles, sorter.order(), kReorderBlock);
+  keys.assign(sorter.keys().begin(), sorter.keys().end());
 
   result.first_global_index = comm.exclusive_prefix_sum(count);
   result.global_count = comm.sum(static_cast<std::uint64_t>(count));
