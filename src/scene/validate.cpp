@@ -205,6 +205,8 @@ class Checker {
       const std::string where = fmt::format("outlets[{}]", i);
       for (const auto& spec : outlet_keys())
         if (const auto value = spec.get(outlet)) detail::check_value(spec, *value, file_, fmt::format("{}.{}", where, spec.key));
+      if (s_.time_steps == TimeSteps::Block)
+        fail(where, "an outlet needs simulation.time_steps = \"global\" (a changing count has no time bins)");
       for (int a = 0; a < 3; ++a)
         if (!(outlet.region.hi[a] > outlet.region.lo[a]))
           fail(fmt::format("{}.max", where), fmt::format("must be greater than {}.min on every axis; along {}: {} ≤ {}",

@@ -130,11 +130,11 @@ TYPED_TEST(CheckpointTest, DamageIsRefusedWithAReason) {
   const std::uint32_t zero = 0;
   std::memcpy(old.data() + 8, &zero, 4);
   expect_refused<Real>(old,
-                       "format version 0 is not supported: this swirl reads versions 2 and 3 (written by an older swirl)");
+                       "format version 0 is not supported: this swirl reads versions 2, 3 and 4 (written by an older swirl)");
   std::string newer = good;
-  const std::uint32_t four = 4;
-  std::memcpy(newer.data() + 8, &four, 4);
-  expect_refused<Real>(newer, "format version 4 is not supported: this swirl reads versions 2 and 3 (written by a newer swirl)");
+  const std::uint32_t five = 5;
+  std::memcpy(newer.data() + 8, &five, 4);
+  expect_refused<Real>(newer, "format version 5 is not supported: this swirl reads versions 2, 3 and 4 (written by a newer swirl)");
   std::string first = good;
   const std::uint32_t one = 1;
   std::memcpy(first.data() + 8, &one, 4);
