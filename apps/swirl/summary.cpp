@@ -35,7 +35,11 @@ scene::Scene load_scene_file(const std::filesystem::path& file, std::span<const 
 std::string summary_text(const sim::RunSummary& s) {
   std::string out;
   out += fmt::format("  scene            {}\n", s.scene_file);
-  out += fmt::format("  particles        {} ({})\n", s.particles, s.precision);
+  if (s.particles_end != 0 && s.particles_end != s.particles)  // inlets or outlets changed the count
+    out += fmt::format("  particles        {} at the start, {} at the end ({})\n", s.particles, s.particles_end,
+                       s.precision);
+  else
+    out += fmt::format("  particles        {} ({})\n", s.particles, s.precision);
   out += fmt::format("  steps            {} (t = {:.6g}{}{})\n", s.steps, s.sim_time, s.time_unit.empty() ? "" : " ",
                      s.time_unit);
   out += fmt::format("  wall time        {:.3f} s\n", s.wall_seconds);
@@ -61,11 +65,11 @@ std::string summary_json(const sim::RunSummary& s) {
   return fmt::format(
       "{{\n"
       "  \"scene\": {},\n  \"precision\": {},\n  \"out_dir\": {},\n  \"threads\": {},\n  \"simd\": \"{}\",\n"
-      "  \"particles\": {},\n  \"steps\": {},\n  \"sim_time\": {:.17g},\n  \"wall_seconds\": {:.9g},\n"
+      "  \"particles\": {},\n  \"particles_end\": {},\n  \"steps\": {},\n  \"sim_time\": {:.17g},\n  \"wall_seconds\": {:.9g},\n"
       "  \"steps_per_second\": {:.9g},\n  \"phase_seconds\": {{{}}},\n  \"bytes_per_particle\": {},\n"
       "  \"frames\": {},\n{}  \"completed\": {},\n  \"failed_checks\": [{}],\n  \"error\": {}\n}}\n",
       json_string(s.scene_file), json_string(s.precision), json_string(s.out_dir.string()), s.threads,
-      simd::isa_name(simd::active()), s.particles,
+      simd::isa_name(simd::active()), s.particles, s.particles_end,
       s.steps, s.sim_time, s.wall_seconds, s.steps_per_second, phases, s.bytes_per_particle, s.frames, metrics,
       s.error.empty() ? "true" : "false", failed, s.error.empty() ? "null" : json_string(s.error));
 }

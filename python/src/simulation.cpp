@@ -34,6 +34,7 @@
 #include "swirl/io/csv.hpp"
 #include "swirl/io/vtp.hpp"
 #include "swirl/scene/validate.hpp"
+#include "swirl/sim/inlets_outlets.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/observer.hpp"
 
@@ -124,6 +125,8 @@ class TypedSimulation final : public AnySimulation {
       : owned_(std::in_place, BuiltBy{[&] { return sim::build_simulation<Real>(scene); }}), sim_(&*owned_),
         block_size_(scene.block_size), walls_(scene.walls), restitution_(scene.restitution),
         run_info_(picture_info(scene)) {
+    // Inlets and outlets change the count after every step, as in a run (the views notice: count and epoch).
+    if (scene.has_inlets_or_outlets()) inlets_ = std::make_unique<sim::InletsAndOutlets<Real>>(scene);
     add_python_forces(live(), forces);
     // Before start(): storage order is still the order given (a list source), and the
     // first reorder carries the field along like every other.
@@ -157,13 +160,17 @@ class TypedSimulation final : public AnySimulation {
   // The initial forces; once, before anything else (the Python object exists by then, for the forces).
   void start() override {
     live().start();
+    if (inlets_) inlets_->on_start(live(), false);
     conservative_ = std::all_of(live().solvers().begin(), live().solvers().end(),
                                 [](const auto& s) { return s->conserves_energy(); }) &&
                     (!walls_ || restitution_ == 1);
     initial_energy_ = energies().total;
   }
 
-  void step(std::optional<double> land_at) override { live().step(land_at); }
+  void step(std::optional<double> land_at) override {
+    live().step(land_at);
+    if (inlets_) inlets_->on_step(live());
+  }
   double time() const override { return live().time(); }
   std::uint64_t steps() const override { return live().step_count(); }
   std::uint64_t epoch() const override { return live().epoch(); }
@@ -347,6 +354,7 @@ class TypedSimulation final : public AnySimulation {
   bool conservative_ = true;
   double initial_energy_ = 0;
   render::RunInfo run_info_;
+  std::unique_ptr<sim::InletsAndOutlets<Real>> inlets_;  // the scene's inlets and outlets, if any
 };
 
 std::unique_ptr<AnySimulation> make_simulation(const scene::Scene& scene, const Forces& forces,

@@ -928,6 +928,42 @@ std::vector<SourceKey> obstacle_keys(ObstacleSource::Shape shape) {
   return k;
 }
 
+// A fluid fill's keys (fluid_sphere, fluid_mesh): its shape's, then the lattice and the velocity.
+std::vector<SourceKey> fill_keys(FluidFillSource::Shape shape) {
+  std::vector<SourceKey> k;
+  if (shape == FluidFillSource::Shape::Sphere) {
+    k.push_back(field(SourceKey{.key = "center", .unit = "m", .doc = "the centre; the sphere lies inside the box",
+                                .required = true},
+                      in_source(&FluidFillSource::center)));
+    k.push_back(field(SourceKey{.key = "radius", .unit = "m", .range = kPositive, .doc = "the radius", .required = true},
+                      in_source(&FluidFillSource::radius)));
+  } else {
+    k.push_back(field(SourceKey{.key = "file",
+                                .doc = "a closed STL (ASCII or binary) or OBJ surface of triangles, relative to the "
+                                       "scene file's folder (every edge in two triangles, consistently oriented); "
+                                       "saved with a run as the absolute path it resolved to",
+                                .required = true, .type_doc = "string (a path)"},
+                      in_source(&FluidFillSource::file)));
+    k.push_back(field(SourceKey{.key = "scale", .range = kPositive,
+                                .doc = "multiplies the file's coordinates (0.001: a file in mm)"},
+                      in_source(&FluidFillSource::scale)));
+    k.push_back(field(SourceKey{.key = "rotate_deg", .unit = "degrees",
+                                .doc = "turns the scaled mesh about the x, then the y, then the z axis (right-handed, "
+                                       "about the origin)"},
+                      in_source(&FluidFillSource::rotate_deg)));
+    k.push_back(field(SourceKey{.key = "translate", .unit = "m",
+                                .doc = "then moves it; the placed mesh lies inside the box"},
+                      in_source(&FluidFillSource::translate)));
+  }
+  k.push_back(field(SourceKey{.key = "spacing", .unit = "m", .range = kPositive,
+                              .doc = "the lattice constant (the fluid_block's lattice over the shape's bounding box; "
+                                     "the points inside are kept)",
+                              .required = true},
+                    in_source(&FluidFillSource::spacing)));
+  k.push_back(velocity_key<FluidFillSource>("the initial velocity of every particle"));
+  return k;
+}
+
 std::vector<SourceKind> declare_source_kinds() {
   std::vector<SourceKind> kinds;
   kinds.push_back({"lattice", "particles on a cubic lattice filling a region", lattice_keys(false), LatticeSource{}});
@@ -937,6 +973,15 @@ std::vector<SourceKind> declare_source_kinds() {
                    "a lattice whose mass makes an interior particle's SPH density exactly `sph.rest_density` (needs "
                    "`[sph]`)",
                    lattice_keys(true), LatticeSource{}});
+  for (const auto& shape : kFluidFillShapeNames) {
+    FluidFillSource prototype;
+    prototype.shape = shape.value;
+    static constexpr std::string_view docs[] = {
+        "the fluid_block's lattice inside a sphere, at the same mass (needs `[sph]`)",
+        "the fluid_block's lattice inside a closed STL or OBJ surface (generalised winding number), at the same mass "
+        "(needs `[sph]`; docs/sph.md)"};
+    kinds.push_back({shape.name, docs[static_cast<std::size_t>(shape.value)], fill_keys(shape.value), prototype});
+  }
   for (const auto& model : kStellarModelNames) {
     StellarSource prototype;
     prototype.model = model.value;
@@ -991,6 +1036,65 @@ std::vector<ProbeKey> declare_probe_keys() {
   line.set = [](Probe& p, const KeyValue& v) { p.line = std::get<std::vector<Vec3d>>(v); };
   k.push_back(std::move(line));
   return k;
+}
+
+using InletKey = KeySpec<Inlet>;
+using OutletKey = KeySpec<Outlet>;
+
+std::vector<InletKey> declare_inlet_keys() {
+  std::vector<InletKey> k;
+  k.push_back(field(InletKey{.key = "center", .section = "inlets", .unit = "m",
+                             .doc = "the centre of the inlet's disc, inside the box", .required = true},
+                    [](auto& i) { return &i.center; }));
+  k.push_back(field(InletKey{.key = "direction", .section = "inlets",
+                             .doc = "the direction the fluid leaves the disc in (any length > 0); the disc is "
+                                    "perpendicular to it",
+                             .required = true},
+                    [](auto& i) { return &i.direction; }));
+  k.push_back(field(InletKey{.key = "radius", .section = "inlets", .unit = "m", .range = kPositive,
+                             .doc = "the disc's radius", .required = true},
+                    [](auto& i) { return &i.radius; }));
+  k.push_back(field(InletKey{.key = "speed", .section = "inlets", .unit = "m/s", .range = kPositive,
+                             .doc = "the speed of the entering fluid along `direction`", .required = true},
+                    [](auto& i) { return &i.speed; }));
+  k.push_back(field(InletKey{.key = "spacing", .section = "inlets", .unit = "m", .range = kPositive,
+                             .doc = "the distance between its particles across the disc and between its layers "
+                                    "(a layer every spacing/speed: the fluid enters at the rest density); the "
+                                    "mass per particle is a fluid_block's at this spacing",
+                             .required = true},
+                    [](auto& i) { return &i.spacing; }));
+  k.push_back(field(InletKey{.key = "start", .section = "inlets", .unit = "s", .range = kNonNegative,
+                             .doc = "when the first layer leaves the disc"},
+                    [](auto& i) { return &i.start; }));
+  k.push_back(field(InletKey{.key = "stop", .section = "inlets", .unit = "s", .range = kPositive,
+                             .doc = "no layer leaves at or after this time (> `start`)",
+                             .default_doc = "never"},
+                    [](auto& i) { return &i.stop; }));
+  return k;
+}
+
+std::vector<OutletKey> declare_outlet_keys() {
+  std::vector<OutletKey> k;
+  k.push_back(field(OutletKey{.key = "min", .section = "outlets", .unit = "m",
+                              .doc = "the outlet box's low corner (it may reach outside the scene's box)",
+                              .required = true},
+                    [](auto& o) { return &o.region.lo; }));
+  k.push_back(field(OutletKey{.key = "max", .section = "outlets", .unit = "m",
+                              .doc = "its high corner, greater than `min` on every axis; fluid particles inside are "
+                                     "removed after every step",
+                              .required = true},
+                    [](auto& o) { return &o.region.hi; }));
+  return k;
+}
+
+const std::vector<InletKey>& inlet_key_list() {
+  static const std::vector<InletKey> keys = declare_inlet_keys();
+  return keys;
+}
+
+const std::vector<OutletKey>& outlet_key_list() {
+  static const std::vector<OutletKey> keys = declare_outlet_keys();
+  return keys;
 }
 
 const std::vector<ProbeKey>& probe_key_list() {
@@ -1086,10 +1190,13 @@ constexpr std::string_view kRegionClose = "<!-- /scene-keys -->";
 std::span<const KeySpec<Scene>> scene_keys() { return scene_key_list(); }
 
 std::span<const KeySpec<Probe>> probe_keys() { return probe_key_list(); }
+std::span<const KeySpec<Inlet>> inlet_keys() { return inlet_key_list(); }
+std::span<const KeySpec<Outlet>> outlet_keys() { return outlet_key_list(); }
 
 std::span<const std::string_view> scene_sections() {
   static constexpr std::string_view sections[] = {"simulation", "box",    "forces",    "sph",   "random_box",
-                                                  "nbody",      "output", "particles", "probes"};
+                                                  "nbody",      "output", "particles", "probes",
+                                                  "inlets",     "outlets"};
   return sections;
 }
 
@@ -1102,6 +1209,8 @@ const SourceKind& kind_of(const ParticleSource& source) {
     if (kind.prototype.index() != source.index()) return false;
     if (const auto* obstacle = std::get_if<ObstacleSource>(&source))
       return std::get<ObstacleSource>(kind.prototype).shape == obstacle->shape;
+    if (const auto* fill = std::get_if<FluidFillSource>(&source))
+      return std::get<FluidFillSource>(kind.prototype).shape == fill->shape;
     const auto* model = std::get_if<StellarSource>(&source);
     return !model || std::get<StellarSource>(kind.prototype).model == model->model;
   };
@@ -1179,6 +1288,14 @@ std::string key_table_markdown(std::string_view section) {
   }
   if (section == "probes") {
     for (const auto& spec : probe_keys()) out += row(spec, spec.key, Probe{});
+    return out;
+  }
+  if (section == "inlets") {
+    for (const auto& spec : inlet_keys()) out += row(spec, spec.key, Inlet{});
+    return out;
+  }
+  if (section == "outlets") {
+    for (const auto& spec : outlet_keys()) out += row(spec, spec.key, Outlet{});
     return out;
   }
   for (const auto& kind : source_kinds()) {

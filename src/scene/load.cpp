@@ -389,10 +389,12 @@ void read_sph(const Table& top, Scene& s) {
   for (std::size_t i = 0; list && i < list->size() && !spacing; ++i) {
     const auto* src = (*list)[i].as_table();
     const auto* kind = src ? src->get("kind") : nullptr;
-    if (kind && kind->value<std::string>() == "fluid_block") spacing = src->get("spacing");
+    const auto name = kind ? kind->value<std::string>() : std::nullopt;
+    if (name == "fluid_block" || name == "fluid_sphere" || name == "fluid_mesh") spacing = src->get("spacing");
   }
   if (!spacing)
-    t.fail("neighbours", fmt::format("needs a [[particles]] source of kind 'fluid_block' to size h from "
+    t.fail("neighbours", fmt::format("needs a [[particles]] source of kind 'fluid_block', 'fluid_sphere' or "
+                                     "'fluid_mesh' to size h from "
                                      "(or give {})", t.key("smoothing_length")));
   const double s0 = t.reader().number(*spacing, "particles[].spacing", Range{0, std::numeric_limits<double>::infinity(), true, false});
   s.sph->smoothing_length = sph::smoothing_length_for_neighbours(k, s0 * s0 * s0);
@@ -567,7 +569,8 @@ void read_snapshot_file(const Table& t, SnapshotSource& src) {
 // into the scene's TOML) and its triangles read now, so that a missing or
 // broken file is refused when the scene is loaded, and validation counts the
 // particles that will be built. A resume reads it again.
-void read_mesh_file(const Table& t, ObstacleSource& src) {
+template <class Source>  // ObstacleSource or FluidFillSource
+void read_mesh_file(const Table& t, Source& src) {
   const std::filesystem::path path = resolve_scene_file(t, src.file);
   try {
     src.mesh = std::make_shared<const io::TriangleMesh>(io::read_triangle_mesh(path));
@@ -620,16 +623,20 @@ void read_particles(const Table& top, Scene& s) {
       if (!spec.custom_read) t.read(spec, spec.key, source);
     if (auto* list_source = std::get_if<ListSource>(&source)) read_list(t, *list_source);
     if (auto* snapshot = std::get_if<SnapshotSource>(&source)) read_snapshot_file(t, *snapshot);
-    if (kind.name == "fluid_block") {
-      // Its mass is the one that gives the rest density.
-      auto& lattice = std::get<LatticeSource>(source);
-      if (fluid_spacing == 0) fluid_spacing = lattice.spacing;
-      if (!s.sph) t.fail("kind", "a 'fluid_block' needs an [sph] section (its mass comes from sph.rest_density)");
-      if (s.sph->smoothing_length / lattice.spacing > 1000)
+    auto* fill = std::get_if<FluidFillSource>(&source);
+    if (kind.name == "fluid_block" || fill) {
+      // Its mass is the one that gives the rest density (a fill's is the fluid_block's at its spacing).
+      double& spacing = fill ? fill->spacing : std::get<LatticeSource>(source).spacing;
+      double& mass = fill ? fill->mass : std::get<LatticeSource>(source).mass;
+      if (fluid_spacing == 0) fluid_spacing = spacing;
+      if (!s.sph)
+        t.fail("kind", fmt::format("a '{}' needs an [sph] section (its mass comes from sph.rest_density)", kind.name));
+      if (s.sph->smoothing_length / spacing > 1000)
         t.fail("spacing", fmt::format("is over 1000 times smaller than sph.smoothing_length = {}", s.sph->smoothing_length));
-      lattice.mass = sph::lattice_mass_for_density(lattice.spacing, s.sph->smoothing_length, s.sph->rest_density,
-                                                   s.sph->method == sph::SphMethod::Dfsph ? s.sph->kernel
-                                                                                          : sph::SphKernel::Thesis);
+      mass = sph::lattice_mass_for_density(spacing, s.sph->smoothing_length, s.sph->rest_density,
+                                           s.sph->method == sph::SphMethod::Dfsph ? s.sph->kernel
+                                                                                  : sph::SphKernel::Thesis);
+      if (fill && fill->shape == FluidFillSource::Shape::Mesh) read_mesh_file(t, *fill);
     }
     if (auto* obstacle = std::get_if<ObstacleSource>(&source)) {
       if (!s.sph)
@@ -642,6 +649,8 @@ void read_particles(const Table& top, Scene& s) {
     }
     s.sources.push_back(std::move(source));
   }
+  // Without a fluid source, the first inlet's spacing is the fluid's.
+  if (fluid_spacing == 0 && !s.inlets.empty()) fluid_spacing = s.inlets.front().spacing;
   resolve_boundary_spacing(top, s, fluid_spacing);
 }
 
@@ -675,6 +684,46 @@ void read_probes(const Table& top, Scene& s) {
   }
 }
 
+// [[inlets]] and [[outlets]]: tables of declared keys; an inlet's mass is the
+// fluid_block's at its spacing. Where they may be is validate()'s.
+template <class Item>
+std::vector<Item> read_item_list(const Table& top, std::string_view name, std::span<const KeySpec<Item>> keys,
+                                 std::string_view noun) {
+  const Reader& r = top.reader();
+  std::vector<Item> out;
+  const auto* node = top.find(name);
+  if (!node) return out;
+  const auto& list = r.array(*node, name, fmt::format("an array of tables ([[{}]])", name));
+  std::vector<std::string_view> known;
+  for (const auto& spec : keys) known.push_back(spec.key);
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string where = fmt::format("{}[{}]", name, i);
+    if (!list[i].is_table()) r.wrong_type(where, "a table", list[i]);
+    const Table t(r, list[i].as_table(), where);
+    t.only(known, fmt::format("unknown key for {}", noun));
+    Item item;
+    for (const auto& spec : keys) t.read(spec, spec.key, item);
+    out.push_back(std::move(item));
+  }
+  return out;
+}
+
+void read_inlets_and_outlets(const Table& top, Scene& s) {
+  s.inlets = read_item_list<Inlet>(top, "inlets", inlet_keys(), "an inlet");
+  s.outlets = read_item_list<Outlet>(top, "outlets", outlet_keys(), "an outlet");
+  for (std::size_t i = 0; i < s.inlets.size(); ++i) {
+    Inlet& inlet = s.inlets[i];
+    if (!s.sph)
+      top.fail(fmt::format("inlets[{}]", i), "an inlet emits SPH fluid: the scene needs an [sph] section");
+    if (s.sph->smoothing_length / inlet.spacing > 1000)
+      top.fail(fmt::format("inlets[{}].spacing", i),
+               fmt::format("is over 1000 times smaller than sph.smoothing_length = {}", s.sph->smoothing_length));
+    inlet.mass = sph::lattice_mass_for_density(inlet.spacing, s.sph->smoothing_length, s.sph->rest_density,
+                                               s.sph->method == sph::SphMethod::Dfsph ? s.sph->kernel
+                                                                                      : sph::SphKernel::Thesis);
+  }
+}
+
 Scene read_scene(const toml::table& root, std::string_view file) {
   const Reader r(file);
   const Table top(r, &root, "");
@@ -699,6 +748,7 @@ Scene read_scene(const toml::table& root, std::string_view file) {
   forces.read_scene_keys(s);
   read_output(top.table("output"), s);
   resolve_time_step(top.table("simulation"), s);
+  read_inlets_and_outlets(top, s);
   read_particles(top, s);
   read_probes(top, s);
   validate(s);
@@ -814,6 +864,16 @@ std::string canonical_text(const Scene& s) {
     for (const auto& spec : probe_keys())
       if (const auto value = spec.get(probe)) out += fmt::format("{} = {}\n", spec.key, value_text(*value, true));
   }
+  for (const auto& inlet : s.inlets) {
+    out += "[[inlets]]\n";
+    for (const auto& spec : inlet_keys())
+      if (const auto value = spec.get(inlet)) out += fmt::format("{} = {}\n", spec.key, value_text(*value, true));
+  }
+  for (const auto& outlet : s.outlets) {
+    out += "[[outlets]]\n";
+    for (const auto& spec : outlet_keys())
+      if (const auto value = spec.get(outlet)) out += fmt::format("{} = {}\n", spec.key, value_text(*value, true));
+  }
   return out;
 }
 
@@ -839,6 +899,8 @@ Scene parse_scene(std::string_view text, std::string_view file, std::span<const 
         table->insert_or_assign("file", snapshot->file);
       const auto* mesh = std::get_if<ObstacleSource>(&scene.sources[i]);
       if (mesh && mesh->shape == ObstacleSource::Shape::Mesh) table->insert_or_assign("file", mesh->file);
+      const auto* fill = std::get_if<FluidFillSource>(&scene.sources[i]);
+      if (fill && fill->shape == FluidFillSource::Shape::Mesh) table->insert_or_assign("file", fill->file);
     }
   std::ostringstream effective;
   effective << root;

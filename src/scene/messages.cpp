@@ -95,6 +95,8 @@ void check_value(const KeySpec<Owner>& spec, const KeyValue& value, std::string_
 
 template void check_value<Scene>(const KeySpec<Scene>&, const KeyValue&, std::string_view, std::string_view);
 template void check_value<Probe>(const KeySpec<Probe>&, const KeyValue&, std::string_view, std::string_view);
+template void check_value<Inlet>(const KeySpec<Inlet>&, const KeyValue&, std::string_view, std::string_view);
+template void check_value<Outlet>(const KeySpec<Outlet>&, const KeyValue&, std::string_view, std::string_view);
 template void check_value<ParticleSource>(const KeySpec<ParticleSource>&, const KeyValue&, std::string_view,
                                           std::string_view);
 

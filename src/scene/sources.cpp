@@ -10,6 +10,7 @@
 #include "sources.hpp"
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/core/random.hpp"
+#include "swirl/scene/fluid_fill.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/mesh_sampling.hpp"
 #include "swirl/sph/lattice_mass.hpp"
@@ -45,6 +46,14 @@ std::uint64_t source_count(const ParticleSource& source) {
     std::uint64_t operator()(const StellarSource& s) const { return s.count; }
     std::uint64_t operator()(const SnapshotSource& s) const { return s.content ? s.content->positions.size() : 0; }
     std::uint64_t operator()(const ObstacleSource& s) const { return obstacle_count(s); }
+    std::uint64_t operator()(const FluidFillSource& s) const {
+      // Beyond the limits the bound stands for the count (validation refuses it either way).
+      const std::uint64_t bound = fill_lattice_bound(s);
+      if (bound > kMaxParticles) return bound;
+      if (s.shape == FluidFillSource::Shape::Mesh && (!s.mesh || mul_sat(bound, s.mesh->triangles.size()) > kMaxFillWork))
+        return 0;
+      return fill_points(s).size();
+    }
   } count;
   return std::visit(count, source);
 }
@@ -221,6 +230,10 @@ class Filler {
 
   void operator()(const ObstacleSource& s) { put_boundary(obstacle_points(s), s.spacing); }
 
+  void operator()(const FluidFillSource& s) {
+    for (const Vec3d& x : fill_points(s)) put(x, s.velocity, s.mass);
+  }
+
   void operator()(const LatticeSource& s) {
     const auto n = detail::lattice_counts(s);
     const double amplitude = s.jitter * s.spacing;
@@ -326,6 +339,11 @@ void check_buildable(const Scene& scene, std::uint64_t count) {
       throw SceneError(fmt::format("{}: particles[{}].file: {} has not been read, or its triangles name vertices it "
                                    "does not have (load_scene reads it)",
                                    scene.file, k, mesh->file));
+    const auto* fill = std::get_if<FluidFillSource>(&scene.sources[k]);
+    if (fill && fill->shape == FluidFillSource::Shape::Mesh && (!fill->mesh || !mesh_indices_valid(*fill->mesh)))
+      throw SceneError(fmt::format("{}: particles[{}].file: {} has not been read, or its triangles name vertices it "
+                                   "does not have (load_scene reads it)",
+                                   scene.file, k, fill->file));
     const auto* snapshot = std::get_if<SnapshotSource>(&scene.sources[k]);
     if (snapshot && (!snapshot->content || snapshot->content->velocities.size() != snapshot->content->positions.size() ||
                      snapshot->content->masses.size() != snapshot->content->positions.size()))

@@ -10,6 +10,7 @@
 
 #include "messages.hpp"
 #include "sources.hpp"
+#include "swirl/scene/fluid_fill.hpp"
 #include "swirl/scene/initial_conditions.hpp"
 #include "swirl/scene/keys.hpp"
 #include "swirl/scene/mesh_sampling.hpp"
@@ -158,6 +159,7 @@ class Checker {
       else if (const auto* list = std::get_if<ListSource>(&source)) listed(*list, where);
       else if (const auto* snapshot = std::get_if<SnapshotSource>(&source)) snapshot_file(*snapshot, where);
       else if (const auto* obstacle = std::get_if<ObstacleSource>(&source)) obstacle_shape(*obstacle, where);
+      else if (const auto* f = std::get_if<FluidFillSource>(&source)) fill(*f, where);
       else stellar(std::get<StellarSource>(source), where);
       const std::uint64_t n = detail::source_count(source);
       if (n > detail::kMaxParticles)
@@ -175,6 +177,43 @@ class Checker {
   // [[probes]] and output.obstacle_forces (docs/sph.md, Probes): the fluid's,
   // inside the box, lines vertical, names usable as CSV column prefixes and
   // unique among the probes and the obstacles (whose default names count too).
+  // [[inlets]] and [[outlets]] (docs/sph.md, Inlets and outlets).
+  void inlets_and_outlets() const {
+    for (std::size_t i = 0; i < s_.inlets.size(); ++i) {
+      const Inlet& inlet = s_.inlets[i];
+      const std::string where = fmt::format("inlets[{}]", i);
+      const auto key = [&](std::string_view k) { return fmt::format("{}.{}", where, k); };
+      for (const auto& spec : inlet_keys())
+        if (const auto value = spec.get(inlet)) detail::check_value(spec, *value, file_, key(spec.key));
+      if (!s_.sph) fail(where, "an inlet emits SPH fluid: the scene needs an [sph] section");
+      if (s_.time_steps == TimeSteps::Block)
+        fail(where, "an inlet needs simulation.time_steps = \"global\" (new particles have no time bin)");
+      inside(inlet.center, key("center"));
+      if (!(norm(inlet.direction) > 0)) fail(key("direction"), "must not be zero");
+      if (inlet.stop && !(*inlet.stop > inlet.start))
+        fail(key("stop"), fmt::format("must be greater than {} = {}, got {}", key("start"), inlet.start, *inlet.stop));
+      if (!(inlet.mass > 0) || !std::isfinite(inlet.mass))
+        fail(where, fmt::format("its particles' mass is {} (load_scene sets it from [sph]; a Scene built in code "
+                                "must set Inlet::mass)",
+                                inlet.mass));
+      if (inlet.radius / inlet.spacing > 2048)
+        fail(key("radius"), fmt::format("{} is over 2048 spacings ({}): a layer would hold over 13 million particles",
+                                        inlet.radius, inlet.spacing));
+    }
+    for (std::size_t i = 0; i < s_.outlets.size(); ++i) {
+      const Outlet& outlet = s_.outlets[i];
+      const std::string where = fmt::format("outlets[{}]", i);
+      for (const auto& spec : outlet_keys())
+        if (const auto value = spec.get(outlet)) detail::check_value(spec, *value, file_, fmt::format("{}.{}", where, spec.key));
+      if (s_.time_steps == TimeSteps::Block)
+        fail(where, "an outlet needs simulation.time_steps = \"global\" (a changing count has no time bins)");
+      for (int a = 0; a < 3; ++a)
+        if (!(outlet.region.hi[a] > outlet.region.lo[a]))
+          fail(fmt::format("{}.max", where), fmt::format("must be greater than {}.min on every axis; along {}: {} ≤ {}",
+                                                         where, "xyz"[a], outlet.region.hi[a], outlet.region.lo[a]));
+    }
+  }
+
   void probes() const {
     if (s_.obstacle_forces && !s_.has_boundary_particles())
       fail("output.obstacle_forces", "the scene has no boundary particles to measure (no obstacle_* source, and "
@@ -410,6 +449,52 @@ class Checker {
                        o.spacing, kMaxMeshParticles));
   }
 
+  // A fluid_sphere or fluid_mesh: inside the box, a mesh read, finite, closed
+  // and within kMaxFillWork, and at least one particle.
+  void fill(const FluidFillSource& f, std::string_view where) const {
+    const auto key = [&](std::string_view k) { return fmt::format("{}.{}", where, k); };
+    if (f.shape == FluidFillSource::Shape::Mesh) {
+      if (!f.mesh || f.mesh->triangles.empty())
+        fail(key("file"), fmt::format("{} has not been read (load_scene reads it; a Scene built in code must fill "
+                                      "FluidFillSource::mesh with at least one triangle)",
+                                      f.file));
+      if (!mesh_indices_valid(*f.mesh))
+        fail(key("file"), fmt::format("{}: a triangle names a vertex the mesh does not have, or one vertex twice", f.file));
+      if (const std::string problem = mesh_closure_problem(*f.mesh); !problem.empty())
+        fail(key("file"), fmt::format("{}: {}; a fluid_mesh fills the inside of a closed surface", f.file, problem));
+      const std::vector<Vec3d> x = placed_fill_vertices(f);
+      for (std::size_t i = 0; i < x.size(); ++i)
+        if (!std::isfinite(x[i].x) || !std::isfinite(x[i].y) || !std::isfinite(x[i].z))
+          fail(key("scale"), fmt::format("{}: vertex {} lands at {}: scale, rotate_deg and translate must keep the "
+                                         "mesh finite",
+                                         f.file, i, detail::vec_text(x[i])));
+    }
+    const Box<double> b = fill_bounds(f);
+    if (s_.walls && (!s_.box.contains(b.lo) || !s_.box.contains(b.hi))) {
+      if (f.shape == FluidFillSource::Shape::Mesh)
+        fail(key("translate"), fmt::format("{}: the placed mesh reaches outside the box {} (it spans {} to {}); move "
+                                           "it with translate, or shrink it with scale",
+                                           f.file, detail::box_text(s_.box), detail::vec_text(b.lo),
+                                           detail::vec_text(b.hi)));
+      fail(key("radius"), fmt::format("the sphere of radius {} about {} reaches outside the box {}", f.radius,
+                                      detail::vec_text(f.center), detail::box_text(s_.box)));
+    }
+    const std::uint64_t bound = fill_lattice_bound(f);
+    if (bound > detail::kMaxParticles)
+      fail(key("spacing"), fmt::format("the lattice over the shape's bounds {} to {} has {} points, more than the "
+                                       "limit of {} (2^31); is the spacing too small?",
+                                       detail::vec_text(b.lo), detail::vec_text(b.hi), count_text(bound),
+                                       detail::kMaxParticles));
+    if (f.shape == FluidFillSource::Shape::Mesh &&
+        detail::mul_sat(bound, f.mesh->triangles.size()) > kMaxFillWork)
+      fail(key("spacing"), fmt::format("{}: {} lattice points against {} triangles is more than {} (2^34) inside "
+                                       "tests; use a larger spacing or a mesh of fewer triangles",
+                                       f.file, bound, f.mesh->triangles.size(), kMaxFillWork));
+    if (detail::source_count(f) == 0)
+      fail(std::string(where), fmt::format("makes no particles: no lattice point at spacing {} lies inside the {}",
+                                           f.spacing, f.shape == FluidFillSource::Shape::Mesh ? "mesh" : "sphere"));
+  }
+
   void stellar(const StellarSource& m, std::string_view where) const {
     const std::string_view kind = enum_name<StellarSource::Model>(kStellarModelNames, m.model);
     if (s_.walls)
@@ -455,6 +540,7 @@ void validate(const Scene& scene) {
   check.sources();
   check.boundary();
   check.probes();
+  check.inlets_and_outlets();
 }
 
 double dense_cell_table_keys(const Scene& scene) {

@@ -29,6 +29,7 @@
 #include "swirl/scene/validate.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/footprint.hpp"
+#include "swirl/sim/inlets_outlets.hpp"
 #include "swirl/sim/observer.hpp"
 #include "probe_log.hpp"
 
@@ -733,7 +734,13 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   auto progress = std::make_unique<Progress<Real>>(on_progress, total_steps, time_unit);
   std::unique_ptr<ProbeLog<Real>> probes;
   if (scene.has_probe_output()) probes = std::make_unique<ProbeLog<Real>>(scene, options, folder);
-  std::vector<Observer<Real>*> observers{frames.get(), diagnostics.get()};
+  // Inlets and outlets act first: frames, diagnostics and checkpoints see the changed set.
+  std::unique_ptr<InletsAndOutlets<Real>> inlets;
+  if (scene.has_inlets_or_outlets()) inlets = std::make_unique<InletsAndOutlets<Real>>(scene);
+  std::vector<Observer<Real>*> observers;
+  if (inlets) observers.push_back(inlets.get());
+  observers.push_back(frames.get());
+  observers.push_back(diagnostics.get());
   if (probes) observers.push_back(probes.get());
   observers.push_back(guard.get());
   for (const auto& o : added) observers.push_back(o.get());
@@ -761,6 +768,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     SimulationClock clock{header.step, header.time, find_value(values, "clock.previous_dt").value_or(0),
                           find_value(values, "clock.dt_floor").value_or(0)};
     sim.resume(clock, values);
+    summary.particles = static_cast<std::size_t>(sim.global_count());  // the checkpoint's (inlets, outlets)
     for (Observer<Real>* o : observers) o->load_state(values);
     summary.first_step = header.step;
     end = RunEnd::choose(scene, options, header.step, header.time, &values);
@@ -835,6 +843,11 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   summary.steps_per_second = summary.wall_seconds > 0 ? static_cast<double>(summary.steps) / summary.wall_seconds : 0;
   summary.phases = sim.timers().phases();
   summary.frames = frames->frames();
+  summary.particles_end = static_cast<std::size_t>(sim.global_count());
+  if (inlets) {
+    summary.metrics.emplace_back("inlet_particles", double(inlets->emitted()));
+    summary.metrics.emplace_back("outlet_particles", double(inlets->removed()));
+  }
   for (const auto& s : sim.solvers()) s->add_metrics(summary.metrics);
   sim.stepper().add_metrics(summary.metrics);
   if (const auto error = diagnostics->energy_error()) summary.metrics.emplace_back("relative_energy_error", *error);
@@ -868,6 +881,7 @@ std::string distributed_support_of(const scene::Scene& scene) {
     const std::string no = sph::SphFluid<Real>(*scene.sph).distributed_support();
     if (!no.empty()) return no;
   }
+  if (scene.has_inlets_or_outlets()) return "inlets and outlets ([[inlets]], [[outlets]]: a particle count that changes)";
   // Boundary particles (box.walls = "particles", obstacles) run on ranks too.
   // probes.csv samples the whole set on one rank; on ranks it would need the
   // gathered state every probe row (docs/sph.md, Probes).

@@ -482,6 +482,12 @@ ViewResult view_scene(const scene::Scene& scene, const ViewOptions& options) {
   if (options.surface && !scene.sph)
     throw std::invalid_argument(fmt::format("swirl view: --surface draws an SPH fluid's surface, and {} has no [sph]",
                                             scene.file));
+  // The live session steps the simulation itself and tells the page the count once.
+  if (scene.has_inlets_or_outlets())
+    throw std::invalid_argument(fmt::format("swirl view: {} has inlets or outlets, whose changing particle count the "
+                                            "live view does not follow yet; run it with swirl run and view the run "
+                                            "folder",
+                                            scene.file));
   if (options.threads > 0) parallel::set_thread_count(options.threads);
   if (scene.precision == scene::Precision::Float) return LiveSession<float>(scene, options).run();
   return LiveSession<double>(scene, options).run();

@@ -130,11 +130,11 @@ TYPED_TEST(CheckpointTest, DamageIsRefusedWithAReason) {
   const std::uint32_t zero = 0;
   std::memcpy(old.data() + 8, &zero, 4);
   expect_refused<Real>(old,
-                       "format version 0 is not supported: this swirl reads versions 2 and 3 (written by an older swirl)");
+                       "format version 0 is not supported: this swirl reads versions 2, 3 and 4 (written by an older swirl)");
   std::string newer = good;
-  const std::uint32_t four = 4;
-  std::memcpy(newer.data() + 8, &four, 4);
-  expect_refused<Real>(newer, "format version 4 is not supported: this swirl reads versions 2 and 3 (written by a newer swirl)");
+  const std::uint32_t five = 5;
+  std::memcpy(newer.data() + 8, &five, 4);
+  expect_refused<Real>(newer, "format version 5 is not supported: this swirl reads versions 2, 3 and 4 (written by a newer swirl)");
   std::string first = good;
   const std::uint32_t one = 1;
   std::memcpy(first.data() + 8, &one, 4);
@@ -186,7 +186,7 @@ TYPED_TEST(CheckpointTest, AVersion3FileStampedVersion2IsRefused) {
 
 // A file written by the version-2 writer (a seed of the fuzz corpus, kept as
 // it was written) is still read: it has no integer fields, and it holds what
-// its version-3 rewrite holds.
+// its rewrite in the current version holds.
 TEST(CheckpointVersions, AVersion2FileIsRead) {
   const std::filesystem::path seeds = std::filesystem::path(SWIRL_SOURCE_DIR) / "tests" / "fuzz" / "corpus" / "checkpoint";
   ParticleSet<double> old_file, new_file;
@@ -194,7 +194,7 @@ TEST(CheckpointVersions, AVersion2FileIsRead) {
   const auto h2 = read_checkpoint(seeds / "nbody_double_4_v2.ckp", old_file, old_values);
   const auto h3 = read_checkpoint(seeds / "nbody_double_4.ckp", new_file, new_values);
   EXPECT_EQ(h2.version, 2u);
-  EXPECT_EQ(h3.version, 3u);
+  EXPECT_EQ(h3.version, kCheckpointVersion);
   EXPECT_EQ(read_checkpoint_header(seeds / "nbody_double_4_v2.ckp").version, 2u);
   EXPECT_EQ(h2.particles, 4u);
   EXPECT_EQ(h2.step, h3.step);
@@ -203,6 +203,23 @@ TEST(CheckpointVersions, AVersion2FileIsRead) {
   EXPECT_EQ(old_file.int_field_count(), 0u);
   EXPECT_EQ(old_values, new_values);
   EXPECT_FALSE(old_file.fields().empty());
+  expect_same(old_file, new_file);
+}
+
+// A file of version 3 (the layout of version 4, written before inlets and
+// outlets could change the count) is read as its version-4 rewrite.
+TEST(CheckpointVersions, AVersion3FileIsRead) {
+  const std::filesystem::path seeds = std::filesystem::path(SWIRL_SOURCE_DIR) / "tests" / "fuzz" / "corpus" / "checkpoint";
+  ParticleSet<float> old_file, new_file;
+  CheckpointValues old_values, new_values;
+  const auto h3 = read_checkpoint(seeds / "sph_kind_float_3_v3.ckp", old_file, old_values);
+  const auto h4 = read_checkpoint(seeds / "sph_kind_float_3.ckp", new_file, new_values);
+  EXPECT_EQ(h3.version, 3u);
+  EXPECT_EQ(h4.version, 4u);
+  EXPECT_EQ(h3.particles, h4.particles);
+  EXPECT_EQ(h3.step, h4.step);
+  EXPECT_EQ(old_file.int_field_count(), 1u);
+  EXPECT_EQ(old_values, new_values);
   expect_same(old_file, new_file);
 }
 

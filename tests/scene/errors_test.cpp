@@ -156,7 +156,7 @@ TEST(SceneErrors, ConflictsAndLengths) {
 TEST(SceneErrors, UnknownNamesListTheAllowedOnes) {
   for (const Case& c : std::vector<Case>{
            {"kind", full("kind = \"random\"", "kind = \"grid\""),
-            "particles[1].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list', 'fluid_block', 'plummer', 'uniform_sphere', 'uniform_cube', 'cold_collapse', 'plummer_collision', 'hernquist', 'nfw', 'king', 'disk_galaxy', 'snapshot', 'obstacle_box', 'obstacle_sphere', 'obstacle_cylinder', 'obstacle_plane', 'obstacle_mesh')"},
+            "particles[1].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list', 'fluid_block', 'fluid_sphere', 'fluid_mesh', 'plummer', 'uniform_sphere', 'uniform_cube', 'cold_collapse', 'plummer_collision', 'hernquist', 'nfw', 'king', 'disk_galaxy', 'snapshot', 'obstacle_box', 'obstacle_sphere', 'obstacle_cylinder', 'obstacle_plane', 'obstacle_mesh')"},
            {"precision", full("precision = \"double\"", "precision = \"single\""),
             "simulation.precision: unknown precision 'single' (allowed: 'float', 'double')"},
            {"format", full("format = [\"csv\", \"vtp\"]", "format = \"xml\""),

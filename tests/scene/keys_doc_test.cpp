@@ -69,6 +69,8 @@ TEST(KeysDoc, TheFuzzDictionaryNamesEveryKey) {
   };
   for (const auto& spec : scene_keys()) expect_named(spec.key);
   for (const auto& spec : probe_keys()) expect_named(spec.key);
+  for (const auto& spec : inlet_keys()) expect_named(spec.key);
+  for (const auto& spec : outlet_keys()) expect_named(spec.key);
   for (const auto& kind : source_kinds()) {
     EXPECT_NE(dict.find("\\\"" + std::string(kind.name) + "\\\""), std::string::npos)
         << "tests/fuzz/scene.dict lacks the kind \"" << kind.name << "\" (as str_NAME=\"\\\"NAME\\\"\")";

@@ -75,7 +75,7 @@ TEST(Overrides, AreValidatedLikeTheFile) {
             "scene.toml: box.restitutoin: unknown key (did you mean 'restitution'?)");
   EXPECT_EQ(error_of(kFullScene, {"solver.kind=\"sph\""}), "scene.toml: solver: unknown section");
   EXPECT_EQ(error_of(kFullScene, {"particles.0.kind=\"grid\""}),
-            "scene.toml: particles[0].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list', 'fluid_block', 'plummer', 'uniform_sphere', 'uniform_cube', 'cold_collapse', 'plummer_collision', 'hernquist', 'nfw', 'king', 'disk_galaxy', 'snapshot', 'obstacle_box', 'obstacle_sphere', 'obstacle_cylinder', 'obstacle_plane', 'obstacle_mesh')");
+            "scene.toml: particles[0].kind: unknown kind 'grid' (allowed: 'lattice', 'random', 'list', 'fluid_block', 'fluid_sphere', 'fluid_mesh', 'plummer', 'uniform_sphere', 'uniform_cube', 'cold_collapse', 'plummer_collision', 'hernquist', 'nfw', 'king', 'disk_galaxy', 'snapshot', 'obstacle_box', 'obstacle_sphere', 'obstacle_cylinder', 'obstacle_plane', 'obstacle_mesh')");
   EXPECT_EQ(error_of(kFullScene, {"particles.1.count=1e99"}),
             "scene.toml: particles[1].count: expected an integer, got a float");
 }

@@ -90,6 +90,27 @@ class ParticleSet {
     id.resize(n);
   }
 
+  // Removes the particles i for which remove(i) is true, the others keeping
+  // their order (every field and the ids); returns how many were removed.
+  template <class Remove>
+  std::size_t remove_if(Remove&& remove) {
+    std::vector<std::size_t> kept;
+    kept.reserve(size());
+    for (std::size_t i = 0; i < size(); ++i)
+      if (!remove(i)) kept.push_back(i);
+    const std::size_t removed = size() - kept.size();
+    if (removed == 0) return 0;
+    // kept[k] ≥ k: moving forward in place never overwrites an entry still to move.
+    const auto compact = [&](auto& a) {
+      for (std::size_t k = 0; k < kept.size(); ++k) a[k] = a[kept[k]];
+      a.resize(kept.size());
+    };
+    for_each_array(compact);
+    for_each_int_array(compact);
+    compact(id);
+    return removed;
+  }
+
   // Calls f(AlignedVector<Real>&) for every real array, built-in and extra, in
   // fields() order (component by component). The ids are not included.
   // Allocates nothing (unlike fields()): cheap enough for a per-block pass.

@@ -2,7 +2,7 @@
 // file, so that a run stopped and resumed ends bit-identical to one that never
 // stopped.
 //
-// Layout (little-endian), format version 3:
+// Layout (little-endian), format version 4:
 //   "SWIRLCKP"                          magic, 8 bytes
 //   u32 version, u32 real_bytes (4 | 8), u64 particles, u64 scene_hash,
 //   u64 step, f64 time
@@ -29,7 +29,14 @@
 // the header. Names are unique across real and integer fields.
 //
 // Versions:
-//   3 (this one): version 2 plus the integer fields (their list after the real
+//   4 (this one): the layout of version 3. What is new is what a file may
+//     hold: a particle count other than the scene's, and ids up to and beyond
+//     it, gaps where particles left (inlets and outlets change the count
+//     during a run: sim/inlets_outlets.hpp), and the inlets' state among the
+//     values ("inlets.<k>.layers", "inlets.next_id", "inlets.emitted",
+//     "inlets.removed"). Version 3 files are still read (they come from runs
+//     whose count never changed, which is what they hold).
+//   3: version 2 plus the integer fields (their list after the real
 //     fields', their data after the real data).
 //   2: the run's values under owner prefixes, written since the
 //     solver/stepper/observer seams; no integer fields (neither
@@ -54,7 +61,7 @@
 
 namespace swirl::io {
 
-inline constexpr std::uint32_t kCheckpointVersion = 3;                // what write_checkpoint writes
+inline constexpr std::uint32_t kCheckpointVersion = 4;                // what write_checkpoint writes
 inline constexpr std::uint32_t kOldestReadableCheckpointVersion = 2;  // the oldest read_checkpoint reads
 
 struct CheckpointHeader {

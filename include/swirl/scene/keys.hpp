@@ -105,8 +105,12 @@ std::span<const KeySpec<Scene>> scene_keys();
 // The keys of one [[probes]] table.
 std::span<const KeySpec<Probe>> probe_keys();
 
+// The keys of one [[inlets]] table, and of one [[outlets]] table.
+std::span<const KeySpec<Inlet>> inlet_keys();
+std::span<const KeySpec<Outlet>> outlet_keys();
+
 // The section tables, in order ("" is the root); `particles` is the array of
-// sources, `probes` the array of probes.
+// sources, `probes` the array of probes, `inlets` and `outlets` theirs.
 std::span<const std::string_view> scene_sections();
 
 // Every kind of [[particles]] source, in the order of the `kind` names.

@@ -73,6 +73,38 @@ struct LatticeSource {
   Vec3d velocity{};         // initial velocity of every particle
 };
 
+// A fluid filling a sphere or a closed triangle mesh (kinds "fluid_sphere",
+// "fluid_mesh"), by the fluid_block's lattice rule applied to the shape's
+// bounding box B: floor(extent_a / spacing) points per axis at
+// B.lo + spacing·(i + ½), of which those inside the shape are kept (a sphere:
+// |x − center| < radius; a mesh: generalised winding number |w| ≥ ½,
+// scene/fluid_fill.hpp). B is [center − radius, center + radius] for a sphere
+// and the placed vertices' bounding box for a mesh, so a mesh cube gives
+// exactly the fluid_block of the same corners. The mass (kg per particle) is
+// the fluid_block's, set by load_scene from [sph] (a Scene built in code
+// sets it). The mesh must be closed and consistently oriented (every edge in
+// exactly two triangles, once in each direction).
+struct FluidFillSource {
+  enum class Shape { Sphere, Mesh };
+  Shape shape = Shape::Sphere;
+  Vec3d center{};           // sphere: its centre (m)
+  double radius = 0;        // sphere: its radius (m, > 0)
+  double spacing = 0;       // lattice constant (m, > 0)
+  double mass = 0;          // per particle (kg, > 0)
+  Vec3d velocity{};         // initial velocity of every particle (m/s)
+  // mesh: the file and its placement, as an obstacle_mesh's: x' = R·(scale·x) + translate.
+  std::string file;
+  double scale = 1;
+  Vec3d rotate_deg{};
+  Vec3d translate{};
+  std::shared_ptr<const io::TriangleMesh> mesh;  // filled by load_scene (as ObstacleSource::mesh)
+};
+
+inline constexpr std::array<EnumName<FluidFillSource::Shape>, 2> kFluidFillShapeNames{{
+    {"fluid_sphere", FluidFillSource::Shape::Sphere},
+    {"fluid_mesh", FluidFillSource::Shape::Mesh},
+}};
+
 // `count` particles placed uniformly at random in `region`.
 struct RandomSource {
   Box<double> region;
@@ -212,6 +244,33 @@ struct Probe {
   std::vector<Vec3d> line;     // a line probe: its lower and upper end (m), same x and y; empty otherwise
 };
 
+// An inlet ([[inlets]]; docs/sph.md, Inlets and outlets): a disc of `radius`
+// about `center`, facing `direction`, through which fluid particles enter at
+// `speed` along it. Its particles sit on a square lattice of the inlet's
+// `spacing` in the disc's plane (the points a·s·u + b·s·v, a and b integers,
+// strictly within the radius; u, v the disc's axes); a new layer leaves it
+// every spacing/speed of simulated time from `start` on (layer k at
+// start + k·spacing/speed), so the fluid enters at the rest density, and none
+// after `stop`. A layer is added after the step that reaches its time, moved
+// the distance it has travelled since. Mass per particle: the fluid_block's
+// at the inlet's spacing (load_scene sets it from [sph]).
+struct Inlet {
+  Vec3d center{};                 // m, inside the box
+  Vec3d direction{0, 0, -1};      // any length > 0: the flow's direction
+  double radius = 0;              // m, > 0
+  double speed = 0;               // m/s, > 0
+  double spacing = 0;             // m, > 0
+  double start = 0;               // s, ≥ 0
+  std::optional<double> stop;     // s, > start; none: emits to the end of the run
+  double mass = 0;                // kg per particle (resolved)
+};
+
+// An outlet ([[outlets]]): a box from which fluid particles are removed after
+// every step (boundary particles stay). It may reach outside the scene's box.
+struct Outlet {
+  Box<double> region;             // m: min < max on every axis
+};
+
 // The obstacle shapes' names, which are also their [[particles]] kinds.
 inline constexpr std::array<EnumName<ObstacleSource::Shape>, 5> kObstacleShapeNames{{
     {"obstacle_box", ObstacleSource::Shape::Box},
@@ -221,7 +280,8 @@ inline constexpr std::array<EnumName<ObstacleSource::Shape>, 5> kObstacleShapeNa
     {"obstacle_mesh", ObstacleSource::Shape::Mesh},
 }};
 
-using ParticleSource = std::variant<LatticeSource, RandomSource, ListSource, StellarSource, SnapshotSource, ObstacleSource>;
+using ParticleSource =
+    std::variant<LatticeSource, RandomSource, ListSource, StellarSource, SnapshotSource, ObstacleSource, FluidFillSource>;
 
 // box.walls: the thesis's clamp (the box's two passes), or the box's faces
 // sampled by boundary particles just outside it (scene::wall_offset(): where
@@ -290,6 +350,8 @@ struct Scene {
   double probes_interval = 0;              // output.probes_interval, s of simulated time
   bool obstacle_forces = false;            // output.obstacle_forces
   std::vector<Probe> probes;               // [[probes]]
+  std::vector<Inlet> inlets;               // [[inlets]]
+  std::vector<Outlet> outlets;             // [[outlets]]
 
   std::vector<ParticleSource> sources;     // [[particles]]; a "fluid_block" becomes a LatticeSource
                                            // whose mass gives the rest density (sph::lattice_mass_for_density)
@@ -318,6 +380,9 @@ struct Scene {
 
   // True when the run writes probes.csv: probes, or the obstacles' forces.
   bool has_probe_output() const { return !probes.empty() || obstacle_forces; }
+
+  // True when the particle count changes during a run (inlets or outlets).
+  bool has_inlets_or_outlets() const { return !inlets.empty() || !outlets.empty(); }
 
   // True when the scene has boundary particles (box.walls = "particles" or an obstacle source).
   bool has_boundary_particles() const {

@@ -136,7 +136,8 @@ struct RunSummary {
   std::string precision;                // "float" | "double"
   std::filesystem::path out_dir;
   int threads = 1;
-  std::size_t particles = 0;
+  std::size_t particles = 0;            // at the start (of this run, or of the resumed state)
+  std::size_t particles_end = 0;        // at the end: differs with inlets and outlets
   std::uint64_t steps = 0;              // steps actually taken
   double sim_time = 0;                  // reached, in time_unit
   std::string time_unit = "s";          // "s" (simulation.units = "si"), "" in N-body units

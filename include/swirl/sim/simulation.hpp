@@ -241,6 +241,28 @@ class Simulation {
     started_ = true;
   }
 
+  // Changes the particles between steps (inlets and outlets,
+  // sim/inlets_outlets.hpp): edit(particles()) may remove particles
+  // (ParticleSet::remove_if) and add new ones at the end (resize), with their
+  // position, velocity, mass, id and kind set and every other field zero.
+  // The state is then made whole again as start() makes it: the order is redone
+  // (the epoch changes), the stepper's start() evaluates the forces at the
+  // current positions (new particles get their acceleration, the fluid its
+  // density and DFSPH factor; a resumed run re-evaluates the same state), and
+  // the limits follow the new state. Serial edits and the usual passes: the
+  // same bits for any thread count. One rank only.
+  template <class Edit>
+  void change_particles(Edit&& edit) {
+    if (!started_) throw std::logic_error("Simulation::change_particles() before start()");
+    if (ranks_) throw std::logic_error("Simulation::change_particles() on several ranks: a changing count is not distributed");
+    edit(particles_);
+    order_.touch();
+    Evaluation forces(*this);
+    stepper_->start(particles_, forces, time(), settings_.block_size);
+    rescan();
+    if (scan_.non_finite != kNoParticle) throw_non_finite(scan_.non_finite);
+  }
+
   // The state beyond the particle fields that resume() needs (with clock()).
   void save_state(NamedValues& out) const {
     stepper_->save_state(out);
