@@ -871,6 +871,8 @@ std::string distributed_support_of(const scene::Scene& scene) {
   // probes.csv samples the whole set on one rank; on ranks it would need the
   // gathered state every probe row (docs/sph.md, Probes).
   if (scene.has_probe_output()) return "probes ([[probes]], output.obstacle_forces)";
+  // Their rest positions are built on rank 0; the ranks would each need them.
+  if (scene.has_moving_obstacles()) return "moving obstacles (an obstacle's `motion`)";
   return {};
 }
 
