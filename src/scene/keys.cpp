@@ -31,6 +31,9 @@ constexpr std::span<const EnumName<Units>> names_of(Units) { return kUnitsNames;
 constexpr std::span<const EnumName<SurfaceFormat>> names_of(SurfaceFormat) { return kSurfaceFormatNames; }
 constexpr std::span<const EnumName<TimeSteps>> names_of(TimeSteps) { return kTimeStepsNames; }
 constexpr std::span<const EnumName<Walls>> names_of(Walls) { return kWallsNames; }
+constexpr std::span<const EnumName<boundary::RigidMotion::Kind>> names_of(boundary::RigidMotion::Kind) {
+  return boundary::kRigidMotionNames;
+}
 constexpr std::span<const EnumName<OutputFormat>> names_of(OutputFormat) { return kOutputFormatNames; }
 constexpr std::span<const EnumName<sph::PressureForm>> names_of(sph::PressureForm) { return sph::kPressureFormNames; }
 constexpr std::span<const EnumName<sph::NegativePressure>> names_of(sph::NegativePressure) {
@@ -205,6 +208,19 @@ auto in_source(M Source::*member) {
   return [member](auto& src) {
     auto* s = std::get_if<Source>(&src);
     return s ? &(s->*member) : nullptr;
+  };
+}
+
+// A field of an obstacle's `motion`: present when the obstacle moves with a
+// kind that uses it (`kinds`: a bit per RigidMotion::Kind), so that a key of
+// another kind is neither hashed nor checked, and a static obstacle has none.
+template <class M>
+auto in_motion(M boundary::RigidMotion::*member, unsigned kinds) {
+  return [member, kinds](auto& src) {
+    auto* o = std::get_if<ObstacleSource>(&src);
+    using Pointer = decltype(&((*o->motion).*member));
+    if (!o || !o->motion || !(kinds & (1u << static_cast<unsigned>(o->motion->kind)))) return Pointer(nullptr);
+    return &((*o->motion).*member);
   };
 }
 
@@ -925,6 +941,56 @@ std::vector<SourceKey> obstacle_keys(ObstacleSource::Shape shape) {
     if (auto* o = std::get_if<ObstacleSource>(&src)) o->name = std::string(std::get<std::string_view>(v));
   };
   k.push_back(std::move(name));
+  // The `motion` table (boundary/rigid_motion.hpp), read by hand: its kind
+  // says which of the keys below it takes. Absent: a static obstacle, and
+  // none of them is in the hash.
+  constexpr unsigned kPiston = 1, kFlap = 2, kRotation = 4, kAnyMotion = 7;
+  const auto motion = [&](SourceKey spec, auto member, unsigned kinds) {
+    spec.custom_read = true;
+    k.push_back(field(std::move(spec), in_motion(member, kinds)));
+  };
+  motion({.key = "motion.kind", .noun = "motion",
+          .doc = "a prescribed rigid motion of the obstacle as placed above (its rest position; docs/sph.md, Moving "
+                 "obstacles): `\"piston\"` (a translation), `\"flap\"` (an oscillating rotation about a hinge) or "
+                 "`\"rotation\"` (a steady one); its particles are put at the motion's x and v before every force "
+                 "evaluation (grid search, one MPI rank)",
+          .default_doc = "– (static)"},
+         &boundary::RigidMotion::kind, kAnyMotion);
+  motion({.key = "motion.direction",
+          .doc = "piston: the stroke's direction (any length > 0): the shift is A·r(τ)·sin(2πfτ + φ) along it, τ = "
+                 "t − `motion.start`",
+          .required = true},
+         &boundary::RigidMotion::direction, kPiston);
+  motion({.key = "motion.amplitude", .unit = "m", .range = kPositive, .doc = "piston: A, half the stroke",
+          .required = true},
+         &boundary::RigidMotion::amplitude, kPiston);
+  motion({.key = "motion.amplitude_deg", .unit = "degrees", .range = Range{0, 180, true, false},
+          .doc = "flap: θ_A: the angle about `motion.axis` is θ_A·r(τ)·sin(2πfτ + φ)", .required = true},
+         &boundary::RigidMotion::amplitude_deg, kFlap);
+  motion({.key = "motion.frequency", .unit = "Hz", .range = kPositive, .doc = "piston, flap: f", .required = true},
+         &boundary::RigidMotion::frequency, kPiston | kFlap);
+  motion({.key = "motion.phase_deg", .unit = "degrees", .doc = "piston, flap: φ (≠ 0 without a ramp: the obstacle "
+                                                                "starts displaced)",
+          .default_doc = "`0`"},
+         &boundary::RigidMotion::phase_deg, kPiston | kFlap);
+  motion({.key = "motion.axis",
+          .doc = "flap, rotation: the hinge's or the shaft's direction (any length > 0; angles right-handed about it)",
+          .required = true},
+         &boundary::RigidMotion::axis, kFlap | kRotation);
+  motion({.key = "motion.point", .unit = "m", .doc = "flap, rotation: a point on the axis", .required = true},
+         &boundary::RigidMotion::point, kFlap | kRotation);
+  motion({.key = "motion.angular_velocity", .unit = "rad/s",
+          .doc = "rotation: ω0 ≠ 0; the angle is ω0·∫₀^τ r", .required = true},
+         &boundary::RigidMotion::angular_velocity, kRotation);
+  motion({.key = "motion.start", .unit = "s", .range = kNonNegative,
+          .doc = "the motion starts at this time; before it the obstacle rests (at its pose for τ = 0)",
+          .default_doc = "`0`"},
+         &boundary::RigidMotion::start, kAnyMotion);
+  motion({.key = "motion.ramp", .unit = "s", .range = kNonNegative,
+          .doc = "T: the motion eases in as r(τ) = (1 − cos(πτ/T))/2 for τ < T, 1 after, so that x and v are "
+                 "continuous; 0: r = 1, the velocity jumps at `motion.start`",
+          .default_doc = "`0`"},
+         &boundary::RigidMotion::ramp, kAnyMotion);
   return k;
 }
 

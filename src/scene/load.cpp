@@ -114,9 +114,14 @@ std::vector<std::string_view> kind_names() {
   return out;
 }
 
+// The names a source's table may hold: `kind` and its keys, a dotted key by
+// its table ("motion" for "motion.kind", ...).
 std::vector<std::string_view> keys_of(const SourceKind& kind) {
   std::vector<std::string_view> out{"kind"};
-  for (const auto& spec : kind.keys) out.push_back(spec.key);
+  for (const auto& spec : kind.keys) {
+    const std::string_view name = spec.key.substr(0, spec.key.find('.'));
+    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
+  }
   return out;
 }
 
@@ -579,6 +584,29 @@ void read_mesh_file(const Table& t, Source& src) {
   }
 }
 
+// An obstacle's `motion` table: its kind first, which says which of the
+// declared "motion.*" keys it takes (those whose field it has), then those.
+void read_motion(const Table& t, const SourceKind& kind, ParticleSource& source) {
+  const Reader& r = t.reader();
+  const Table m = t.table("motion");
+  std::vector<std::string_view> names;
+  for (const auto& entry : boundary::kRigidMotionNames) names.push_back(entry.name);
+  const std::string_view name = r.choice(m.need("kind"), m.key("kind"), names, "motion");
+  auto& obstacle = std::get<ObstacleSource>(source);
+  obstacle.motion.emplace();
+  obstacle.motion->kind = *enum_value<boundary::RigidMotion::Kind>(boundary::kRigidMotionNames, name);
+  constexpr std::string_view prefix = "motion.";
+  std::vector<std::string_view> known;
+  for (const auto& spec : kind.keys)
+    if (spec.key.starts_with(prefix) && spec.get(source)) known.push_back(spec.key.substr(prefix.size()));
+  m.only(known, fmt::format("unknown key for a '{}' motion", name));
+  for (const auto& spec : kind.keys) {
+    if (!spec.key.starts_with(prefix) || !spec.get(source)) continue;
+    const std::string_view rest = spec.key.substr(prefix.size());
+    if (rest != "kind") m.read(spec, rest, source);
+  }
+}
+
 // Boundary particles are sampled at the fluid's spacing unless told: the
 // walls (box.walls = "particles") and every obstacle without a `spacing` take
 // the first fluid_block's.
@@ -646,6 +674,7 @@ void read_particles(const Table& top, Scene& s) {
         obstacle->spacing = r.number(*given, t.key("spacing"), spec_in<ParticleSource>(kind.keys, "spacing").range);
       obstacle->clip = s.box;
       if (obstacle->shape == ObstacleSource::Shape::Mesh) read_mesh_file(t, *obstacle);
+      if (t.find("motion")) read_motion(t, kind, source);
     }
     s.sources.push_back(std::move(source));
   }

@@ -374,12 +374,12 @@ std::vector<ObstacleIds> obstacle_ids(const Scene& scene) {
     const std::uint64_t n = detail::source_count(source);
     if (const auto* o = std::get_if<ObstacleSource>(&source)) {
       ++k;
-      out.push_back({o->name.empty() ? fmt::format("obstacle{}", k) : o->name, first, n, obstacle_centre(*o)});
+      out.push_back({o->name.empty() ? fmt::format("obstacle{}", k) : o->name, first, n, obstacle_centre(*o), o->motion});
     }
     first = detail::add_sat(first, n);
   }
   if (scene.walls && scene.wall_kind == Walls::Particles)
-    out.push_back({"walls", first, detail::wall_count(scene), (scene.box.lo + scene.box.hi) * 0.5});
+    out.push_back({"walls", first, detail::wall_count(scene), (scene.box.lo + scene.box.hi) * 0.5, std::nullopt});
   return out;
 }
 

@@ -158,8 +158,10 @@ class Checker {
       else if (const auto* r = std::get_if<RandomSource>(&source)) region(r->region, where);
       else if (const auto* list = std::get_if<ListSource>(&source)) listed(*list, where);
       else if (const auto* snapshot = std::get_if<SnapshotSource>(&source)) snapshot_file(*snapshot, where);
-      else if (const auto* obstacle = std::get_if<ObstacleSource>(&source)) obstacle_shape(*obstacle, where);
-      else if (const auto* f = std::get_if<FluidFillSource>(&source)) fill(*f, where);
+      else if (const auto* obstacle = std::get_if<ObstacleSource>(&source)) {
+        obstacle_shape(*obstacle, where);
+        if (obstacle->motion) motion(*obstacle, where);
+      } else if (const auto* f = std::get_if<FluidFillSource>(&source)) fill(*f, where);
       else stellar(std::get<StellarSource>(source), where);
       const std::uint64_t n = detail::source_count(source);
       if (n > detail::kMaxParticles)
@@ -413,6 +415,37 @@ class Checker {
     }
     if (detail::obstacle_count(o) == 0)
       fail(where, fmt::format("makes no boundary particles at spacing {}", o.spacing));
+  }
+
+  // A moving obstacle: a motion of a known kind, its directions not zero, a
+  // rotation that turns, whole steps for everyone, and (with a box) every one
+  // of its particles inside the box at every time: the box's passes would
+  // otherwise reflect the prescribed velocities of those outside.
+  void motion(const ObstacleSource& o, std::string_view where) const {
+    using Kind = boundary::RigidMotion::Kind;
+    const boundary::RigidMotion& m = *o.motion;
+    const auto key = [&](std::string_view k) { return fmt::format("{}.motion.{}", where, k); };
+    const std::string_view name = enum_name<Kind>(boundary::kRigidMotionNames, m.kind);
+    if (name.empty()) fail(key("kind"), "is not a valid motion kind");
+    if (m.kind == Kind::Piston && !(norm(m.direction) > 0)) fail(key("direction"), "must not be zero");
+    if (m.kind != Kind::Piston && !(norm(m.axis) > 0)) fail(key("axis"), "must not be zero");
+    if (m.kind == Kind::Rotation && !(m.angular_velocity != 0))
+      fail(key("angular_velocity"), "must not be 0 (a rotation that does not turn is a static obstacle)");
+    if (s_.time_steps == TimeSteps::Block)
+      fail(key("kind"), "moving obstacles need simulation.time_steps = \"global\"");
+    if (!s_.walls) return;
+    const std::vector<Vec3d> points = obstacle_points(o);
+    if (points.empty()) return;
+    Vec3d lo = boundary::swept_bounds(m, points.front())[0], hi = lo;
+    for (const Vec3d& x : points) {
+      const auto b = boundary::swept_bounds(m, x);
+      for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], b[0][a]), hi[a] = std::max(hi[a], b[1][a]);
+    }
+    if (!s_.box.contains(lo) || !s_.box.contains(hi))
+      fail(key(m.kind == Kind::Piston ? "amplitude" : m.kind == Kind::Flap ? "amplitude_deg" : "point"),
+           fmt::format("the '{}' motion takes the obstacle outside the box {}: its particles sweep {} to {}; moving "
+                       "particles must stay inside the box (a smaller amplitude, or the obstacle further in)",
+                       name, detail::box_text(s_.box), detail::vec_text(lo), detail::vec_text(hi)));
   }
 
   // A mesh obstacle: read, placed at finite coordinates inside the box, and

@@ -111,13 +111,15 @@ class ProbeLog final : public Observer<Real> {
   }
 
   // Each obstacle's force F = Σ F_b and torque Σ (x_b − c) × F_b over its
-  // boundary particles, in memory order.
+  // boundary particles, in memory order (c: the centre at the row's time).
   void add_obstacles(const Simulation<Real>& sim, std::vector<double>& row) {
     const auto* fluid = sim.template find_solver<sph::SphFluid<Real>>();
     if (!fluid) throw std::logic_error("ProbeLog: obstacle forces without the SPH solver");
     const ParticleSet<Real>& p = sim.particles();
     fluid->boundary_forces(p, block_size_, forces_);
     std::vector<std::array<double, 6>> sums(obstacles_.size(), std::array<double, 6>{});
+    std::vector<Vec3d> centres;  // a moving obstacle's torque is about its centre where it is now
+    for (const auto& o : obstacles_) centres.push_back(o.centre_at(sim.time()));
     for (std::size_t i = 0; i < p.size(); ++i) {
       const std::uint64_t id = p.id[i];
       // The obstacles' id ranges are disjoint and in increasing order.
@@ -128,8 +130,9 @@ class ProbeLog final : public Observer<Real> {
       const scene::ObstacleIds& o = obstacles_[k];
       if (id >= o.first + o.count) continue;
       const double fx = forces_[3 * i], fy = forces_[3 * i + 1], fz = forces_[3 * i + 2];
-      const double rx = double(p.position.x[i]) - o.centre.x, ry = double(p.position.y[i]) - o.centre.y,
-                   rz = double(p.position.z[i]) - o.centre.z;
+      const Vec3d& c = centres[k];
+      const double rx = double(p.position.x[i]) - c.x, ry = double(p.position.y[i]) - c.y,
+                   rz = double(p.position.z[i]) - c.z;
       auto& s = sums[k];
       s[0] += fx, s[1] += fy, s[2] += fz;
       s[3] += ry * fz - rz * fy, s[4] += rz * fx - rx * fz, s[5] += rx * fy - ry * fx;

@@ -15,6 +15,7 @@
 
 #include <fmt/format.h>
 
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/dist/gather_particles.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/checkpoint.hpp"
@@ -286,14 +287,19 @@ class DiagnosticsLog final : public Observer<Real> {
     std::array<double, 3> momentum{}, angular{};
   };
   // K = ½ Σ m|v|², P = Σ m v, L = Σ m x × v: in double per block, folded in
-  // block order (the same bits for any thread count).
+  // block order (the same bits for any thread count). Boundary particles are
+  // left out: their "mass" is a volume weight ψ, and a moving obstacle's
+  // prescribed velocity is not the fluid's (static ones would add zeros).
   Mechanics mechanics(const ParticleSet<Real>& p) const {
     using Partial = std::array<double, 7>;
+    const std::size_t kinds = p.find_int_field(kKindField);
+    const std::int32_t* kind = kinds == ParticleSet<Real>::npos ? nullptr : p.int_field(kinds).data();
     const Partial t = parallel::reduce_blocks(
         "mechanics", p.size(), block_size_, Partial{},
         [&](std::size_t b, std::size_t e) {
           Partial s{};
           for (std::size_t i = b; i < e; ++i) {
+            if (kind && is_boundary(kind[i])) continue;
             const double m = p.mass[i];
             const double x = p.position.x[i], y = p.position.y[i], z = p.position.z[i];
             const double vx = p.velocity.x[i], vy = p.velocity.y[i], vz = p.velocity.z[i];
@@ -886,6 +892,8 @@ std::string distributed_support_of(const scene::Scene& scene) {
   // probes.csv samples the whole set on one rank; on ranks it would need the
   // gathered state every probe row (docs/sph.md, Probes).
   if (scene.has_probe_output()) return "probes ([[probes]], output.obstacle_forces)";
+  // Their rest positions are built on rank 0; the ranks would each need them.
+  if (scene.has_moving_obstacles()) return "moving obstacles (an obstacle's `motion`)";
   return {};
 }
 

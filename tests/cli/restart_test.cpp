@@ -66,6 +66,19 @@ TEST_F(Restart, BoundaryParticlesResumeBitIdentically) {
   EXPECT_GT(boundary, 1000u);
 }
 
+// A moving obstacle (the wave flume's piston): its particles' places are a
+// function of t and of the scene, so the checkpoint needs nothing new, and the
+// frames and probes.csv (the paddle's force and torque) resume byte-identical.
+TEST_F(Restart, AMovingPistonResumesBitIdentically) {
+  const std::string flume = kExamples + "wave_flume.toml --set particles.0.spacing=0.05 --set output.interval=0.02";
+  ASSERT_EQ(swirl("run " + flume + " --steps 30 --threads 2 --out " + (dir_ / "a").string()).status, 0);
+  ASSERT_EQ(swirl("run " + flume + " --steps 12 --threads 1 --checkpoint-every-steps 6 --out " + (dir_ / "b").string()).status, 0);
+  const auto r = swirl("run --resume " + (dir_ / "b").string() + " --steps 18 --threads 2");
+  ASSERT_EQ(r.status, 0) << r.err;
+  expect_same_outputs(dir_ / "a", dir_ / "b");
+  EXPECT_NE(slurp(dir_ / "a" / "probes.csv").find("paddle_force_x"), std::string::npos);
+}
+
 // SPH and self-gravity in one run (one order for both, adaptive steps).
 TEST_F(Restart, BothSolversResumeBitIdentically) {
   const std::string drop = std::string(SWIRL_SOURCE_DIR) +

@@ -11,7 +11,9 @@
 // What "boundary" means to the pipeline:
 //  - the simulation zeroes a boundary particle's acceleration after every
 //    force evaluation (sim/simulation.hpp), so that with v = 0 every stepper's
-//    update leaves it exactly where it is (x += 0·Δt + ½·0·Δt²);
+//    update leaves it exactly where it is (x += 0·Δt + ½·0·Δt²); a moving
+//    obstacle's particles are put at their prescribed x and v before every
+//    evaluation instead (boundary/moving_boundaries.hpp);
 //  - the SPH solver (sph/sph_fluid.hpp) stores its volume weight ψ_b in its
 //    mass and leaves it out of the fluid's diagnostics and solves.
 #pragma once

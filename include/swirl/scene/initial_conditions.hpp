@@ -3,6 +3,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -51,7 +52,11 @@ struct ObstacleIds {
   std::string name;  // its `name`, or "obstacle<k>" (k from 1, in source order); "walls" for the walls
   std::uint64_t first = 0;
   std::uint64_t count = 0;
-  Vec3d centre{};
+  Vec3d centre{};    // at rest: a moving obstacle's is carried by its motion
+  std::optional<boundary::RigidMotion> motion;  // its `motion`, if it moves
+
+  // The centre at time t (m).
+  Vec3d centre_at(double t) const { return motion ? motion->pose(t).position(centre) : centre; }
 };
 
 // Every obstacle in source order, then the walls (box.walls = "particles").

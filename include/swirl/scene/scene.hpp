@@ -20,6 +20,7 @@
 #include <variant>
 #include <vector>
 
+#include "swirl/boundary/rigid_motion.hpp"
 #include "swirl/core/box.hpp"
 #include "swirl/core/enum_names.hpp"
 #include "swirl/core/vec3.hpp"
@@ -219,6 +220,11 @@ struct ObstacleSource {
   // Its name in probes.csv (output.obstacle_forces); empty: "obstacle<k>", k
   // counting the scene's obstacles from 1 in source order.
   std::string name;
+  // The `motion` table: a prescribed rigid motion (a piston, a flap, a
+  // rotating paddle; boundary/rigid_motion.hpp) of the obstacle as placed
+  // above, its rest position; none: static. Validation keeps its swept
+  // particles inside the box (when the scene has one).
+  std::optional<boundary::RigidMotion> motion;
 };
 
 // The point about which an obstacle's torque is taken (probes.csv): the
@@ -383,6 +389,13 @@ struct Scene {
 
   // True when the particle count changes during a run (inlets or outlets).
   bool has_inlets_or_outlets() const { return !inlets.empty() || !outlets.empty(); }
+
+  // True when an obstacle has a `motion`.
+  bool has_moving_obstacles() const {
+    for (const auto& s : sources)
+      if (const auto* o = std::get_if<ObstacleSource>(&s); o && o->motion) return true;
+    return false;
+  }
 
   // True when the scene has boundary particles (box.walls = "particles" or an obstacle source).
   bool has_boundary_particles() const {

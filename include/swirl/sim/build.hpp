@@ -10,6 +10,10 @@
 #pragma once
 
 #include <memory>
+#include <variant>
+#include <vector>
+
+#include "swirl/boundary/moving_boundaries.hpp"
 
 #include "swirl/force/damping.hpp"
 #include "swirl/force/uniform_gravity.hpp"
@@ -60,7 +64,19 @@ Simulation<Real> build_simulation(const scene::Scene& scene, ParticleSet<Real> p
         integrate::BlockStepOptions{scene.eta, scene.nbody->softening, int(scene.max_bin)});
   else
     stepper = std::make_unique<integrate::KickDriftStepper<Real>>(integrate::Method::VelocityVerlet, std::move(box));
+  // Moving obstacles: their particles' rest positions, as make_particles
+  // sampled them, by id (boundary/moving_boundaries.hpp).
+  std::vector<boundary::MovingObstacle> moving;
+  const std::vector<scene::ObstacleIds> ids = scene::obstacle_ids(scene);
+  std::size_t k = 0;
+  for (const auto& source : scene.sources)
+    if (const auto* o = std::get_if<scene::ObstacleSource>(&source)) {
+      if (o->motion) moving.push_back({ids.at(k).first, scene::obstacle_points(*o), *o->motion});
+      ++k;
+    }
+  if (fluid && !moving.empty()) fluid->set_moving_boundaries(true);
   Simulation<Real> sim(std::move(particles), settings, std::move(stepper));
+  if (!moving.empty()) sim.set_moving_boundaries(std::make_shared<const boundary::MovingBoundaries>(std::move(moving)));
   if (fluid) sim.add_solver(std::move(fluid));
   if (scene.nbody)
     sim.add_solver(std::make_unique<gravity::GravityForce<Real>>(

@@ -46,6 +46,12 @@
 // gathers the one-rank memory order on rank 0 for frames and checkpoints.
 // So every rank count gives the one-rank bits.
 //
+// Moving obstacles (set_moving_boundaries(), boundary/moving_boundaries.hpp):
+// before every force evaluation at time t, and so before the order's sort,
+// their boundary particles are put at the prescribed motion's position and
+// velocity for t; their acceleration is zeroed as every boundary particle's.
+// They hold no state of their own (the motion is a function of t).
+//
 // Checkpoints: save_state()/resume() carry the clock, the controller, the
 // stepper's and every solver's state; the particle fields (including the
 // order's reference positions when a skin is used) travel in the checkpoint's
@@ -70,6 +76,7 @@
 #include <fmt/format.h>
 
 #include "swirl/boundary/box_collision.hpp"
+#include "swirl/boundary/moving_boundaries.hpp"
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
@@ -140,10 +147,21 @@ class Simulation {
     if (started_) throw std::logic_error("Simulation::distribute() after start()");
     whole_on_root_ = whole_on_root;
     if (comm.distributed()) {
+      if (moving_ && !moving_->empty()) throw std::invalid_argument("moving obstacles do not run on several MPI ranks yet");
       ranks_ = std::make_unique<dist::RankOrder<Real>>(comm);
       ranks_->set_rebalance_threshold(settings_.rebalance_threshold);
     }
   }
+  // Obstacles whose boundary particles follow a prescribed motion (one rank
+  // only: distribute() refuses them). Before start() or resume().
+  void set_moving_boundaries(std::shared_ptr<const boundary::MovingBoundaries> moving) {
+    if (started_) throw std::logic_error("Simulation::set_moving_boundaries() after start()");
+    if (ranks_ && moving && !moving->empty())
+      throw std::invalid_argument("moving obstacles do not run on several MPI ranks yet");
+    moving_ = std::move(moving);
+  }
+  const boundary::MovingBoundaries* moving_boundaries() const { return moving_.get(); }
+
   // The rank order on several ranks, or null.
   const dist::RankOrder<Real>* ranks() const { return ranks_.get(); }
   // Particles in the whole run (this rank's on one rank).
@@ -406,6 +424,8 @@ class Simulation {
                                     for (std::size_t i = b; i < e; ++i) a[i] = Real(0);
                                   }
                                 });
+    // Moving obstacles to their place at t, before the order looks at positions.
+    if (moving_) moving_->apply(particles_, t, settings_.block_size);
     if (ranks_) {
       ++evaluations_on_ranks_;  // the SPH ghosts come and go: buffers may move
       ScopedPhase sort(timers_, "forces.sort");
@@ -436,9 +456,10 @@ class Simulation {
     hold_boundary_particles();
   }
 
-  // Boundary particles (core/particle_kind.hpp) are static: their
+  // Boundary particles (core/particle_kind.hpp) are not integrated: their
   // acceleration is zeroed after every evaluation (gravity and the fluid's
-  // reaction included), so that with v = 0 the steppers leave them in place.
+  // reaction included), so that with v = 0 the steppers leave a static one in
+  // place (a moving one is put at its place by the next evaluation).
   void hold_boundary_particles() {
     const std::size_t k = particles_.find_int_field(kKindField);
     if (k == ParticleSet<Real>::npos) return;
@@ -634,6 +655,7 @@ class Simulation {
   std::unique_ptr<integrate::Stepper<Real>> stepper_;
   std::vector<std::unique_ptr<Solver<Real>>> solvers_;
   spatial::ParticleOrder<Real> order_;
+  std::shared_ptr<const boundary::MovingBoundaries> moving_;  // null: every boundary particle static
   std::unique_ptr<dist::RankOrder<Real>> ranks_;  // several ranks: the global order (order_ unused)
   std::uint64_t evaluations_on_ranks_ = 0;
   bool whole_on_root_ = false;  // distribute(): the set on rank 0 alone until start() or resume()

@@ -25,7 +25,8 @@
 // Boundary particles (Akinci et al. 2012; core/particle_kind.hpp): with a
 // `kind` array (null: all fluid), a boundary particle b carries its volume
 // weight ψ_b = ρ0 / Σ_k W_bk in its mass, so the sums over j above take it as
-// one more neighbour of mass ψ_b at rest (v_b = 0); its own κ stays 0, so the
+// one more neighbour of mass ψ_b moving with its velocity v_b (0 for a static
+// wall, the prescribed one for a moving obstacle); its own κ stays 0, so the
 // pressure term of a pair (i, b) is ψ_b (κ_i/ρ_i) ∇W_ib, the fluid particle's
 // own term (the pressure mirrored onto the wall). In α's second sum only
 // fluid neighbours count (a boundary particle has no κ of its own to solve

@@ -51,6 +51,10 @@
 // Boundary particles (core/particle_kind.hpp, sph/sph_fluid.hpp) are in every
 // pass as neighbours and skipped as particles: κ_b stays 0, v_b stays 0, and
 // a = 0 (the simulation zeroes it), so the kick and the drift leave them put.
+// A moving obstacle's particles (boundary/moving_boundaries.hpp) carry their
+// prescribed v_b through the step's solves (the walls' hold leaves boundary
+// particles alone), and the evaluation of step 4 puts them at their exact x
+// and v for the new time, whatever the drift did to them.
 //
 // Resume: the warm starts are particle fields; the grid and α are not, so the
 // first step after a resume re-evaluates the forces at the restored x (the
@@ -330,6 +334,7 @@ class DfsphStepper final : public integrate::Stepper<Real> {
   // much: the dam break's floor layer reached 6 m/s in 12 steps).
   void hold_at_walls(ParticleSet<Real>& p, std::size_t b, std::size_t e, Real dt) const {
     if (!box_) return;
+    const std::int32_t* kind = SphFluid<Real>::kinds(p);  // boundary particles keep their (prescribed) velocity
     const Real inv_dt = Real(1) / dt;
     for (int axis = 0; axis < 3; ++axis) {
       const Real* x = p.position[axis].data();
@@ -338,7 +343,8 @@ class DfsphStepper final : public integrate::Stepper<Real> {
 #pragma omp simd
       for (std::size_t i = b; i < e; ++i) {
         const Real low = (lo - x[i]) * inv_dt, high = (hi - x[i]) * inv_dt;
-        v[i] = std::min(std::max(v[i], low), high);
+        const Real held = std::min(std::max(v[i], low), high);
+        v[i] = kind && is_boundary(kind[i]) ? v[i] : held;
       }
     }
   }

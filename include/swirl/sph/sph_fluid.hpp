@@ -85,7 +85,18 @@
 // the weakly compressible fluid behind squeezed it there.) These are per-
 // particle entries written between the density and the force pass, so the
 // SIMD force pass and its scalar twin run unchanged. The viscosity treats a
-// boundary particle as a neighbour at rest of volume ψ_b/ρ0 (no-slip walls).
+// boundary particle as a neighbour of volume ψ_b/ρ0 moving with its velocity
+// v_b (no-slip walls; v_b = 0 for static ones).
+// Moving obstacles (boundary/moving_boundaries.hpp; set_moving_boundaries()):
+// the simulation puts their particles at the prescribed x_b and v_b before each
+// evaluation, and every pass already reads v_b where a wall's velocity matters
+// (DFSPH's Dρ/Dt = Σ_j m_j (v_i − v_j)·∇W_ij, the viscosity, boundary_forces()).
+// ψ_b is then recomputed at every evaluation, over all boundary particles:
+// rigid motion keeps an obstacle's own sum, but where it passes another
+// obstacle or the walls their mutual terms come and go, and Akinci's ψ counts
+// every boundary neighbour (one gather over the boundary particles per
+// evaluation; static boundary particles far from the moving ones get their
+// same value back).
 // A boundary particle's own density is reported as ρ0 and its pressure as 0
 // (DFSPH) or p_b (the thesis's); the fluid's diagnostics and the DFSPH errors
 // count fluid particles only. Boundary particles need the grid search.
@@ -310,6 +321,11 @@ class SphFluid final : public Solver<Real> {
   // the boundary particles per step); probes.csv with obstacle forces turns
   // it on before the first step. Changes nothing in the simulation.
   void record_boundary_reactions(bool on) { record_reactions_ = on; }
+
+  // Some boundary particles move (header): ψ_b is recomputed at every
+  // evaluation instead of once. Before the first evaluation.
+  void set_moving_boundaries(bool on) { moving_boundaries_ = on; }
+  bool moving_boundaries() const { return moving_boundaries_; }
   bool records_boundary_reactions() const { return record_reactions_ && dfsph(); }
 
   // DFSPH, right after the constant-density solve (x, ρ and the grid still
@@ -353,7 +369,7 @@ class SphFluid final : public Solver<Real> {
   // evaluated on the current state with the grid of the last evaluation
   // (between steps x, ρ, p are that evaluation's; the viscosity uses the
   // current v). The thesis's solver: a_j←b = norm_p (p_j + p_b) V_b (h − r)²/r
-  // r⃗_jb / ρ_j + norm_μ V_b (h − r)(0 − v_j) / ρ_j, V_b = ψ_b/ρ0 (without the
+  // r⃗_jb / ρ_j + norm_μ V_b (h − r)(v_b − v_j) / ρ_j, V_b = ψ_b/ρ0 (without the
   // gradient correction, when that is on). DFSPH: the last step's pressure
   // impulses over Δt, a_j←b = −ψ_b (κ_j/ρ_j) ∇W_jb: the divergence-free
   // solve's κ^v at the current x, and the constant-density solve's as recorded
@@ -394,7 +410,7 @@ class SphFluid final : public Solver<Real> {
           const double dx = double(x[j]) - double(x[i]), dy = double(y[j]) - double(y[i]), dz = double(z[j]) - double(z[i]);
           const double r = std::sqrt(double(r2)), mj = double(m[j]), rj = double(rho[j]);
           const double q = std::max(double(laws.h) - r, 0.0);
-          double radial = 0;  // a_j←b = radial · r⃗_jb + viscous · (0 − v_j)
+          double radial = 0;  // a_j←b = radial · r⃗_jb + viscous · (v_b − v_j)
           if (dfsph()) {
             const double k = double(kappa_v[j]) + (recorded ? 0.0 : double(kappa[j]));
             radial = r > 0 ? -double(m[i]) * k / rj * double(kernel_->gradient(Real(r))) : 0.0;
@@ -402,9 +418,9 @@ class SphFluid final : public Solver<Real> {
             radial = r > 0 ? norm_p * (double(pr[j]) + double(pr[i])) * volume * q * q / r / rj : 0.0;
           }
           const double viscous = norm_v * volume * q / rj;
-          fx -= mj * (radial * dx - viscous * double(vx[j]));
-          fy -= mj * (radial * dy - viscous * double(vy[j]));
-          fz -= mj * (radial * dz - viscous * double(vz[j]));
+          fx -= mj * (radial * dx + viscous * (double(vx[i]) - double(vx[j])));
+          fy -= mj * (radial * dy + viscous * (double(vy[i]) - double(vy[j])));
+          fz -= mj * (radial * dz + viscous * (double(vz[i]) - double(vz[j])));
         });
         if (recorded) {
           const std::size_t at = 3 * std::size_t(p.id[i]);
@@ -542,7 +558,7 @@ class SphFluid final : public Solver<Real> {
   }
 
   // Boundary particles, once the grid view is up: the fluid count, and (once
-  // for static boundaries) every boundary particle's ψ_b = ρ0 / Σ_k W_bk over
+  // for static boundaries, at every evaluation with moving ones) every boundary particle's ψ_b = ρ0 / Σ_k W_bk over
   // the boundary particles k within h (b included), W the density kernel
   // `w(r², r)`, stored as its mass. Gathers into b only, in the grid's order:
   // the same bits for any thread count, and on a resume (the flag is state).
@@ -560,7 +576,7 @@ class SphFluid final : public Solver<Real> {
       fluid_count_ = ranks_ ? static_cast<std::size_t>(ranks_->comm().sum(std::uint64_t{mine})) : mine;
       counted_ = true;
     }
-    if (boundary_volumes_) return false;
+    if (boundary_volumes_ && !moving_boundaries_) return false;
     const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
     Real* m = p.mass.data();
     const Real h2 = Real(params_.smoothing_length * params_.smoothing_length), rho0 = Real(params_.rest_density);
@@ -974,6 +990,7 @@ class SphFluid final : public Solver<Real> {
   std::uint64_t evaluations_ = 0;
   bool used_grid_ = false;
   bool boundary_volumes_ = false;  // ψ_b computed into the boundary particles' masses (state)
+  bool moving_boundaries_ = false;  // ψ_b recomputed at every evaluation (set_moving_boundaries)
   bool record_reactions_ = false;  // DFSPH: record_density_reaction() after each density solve
   std::vector<double> density_reaction_;  // DFSPH: its result, 3 per id (scratch: a step recomputes it)
   bool counted_ = false;           // fluid_count_ set
