@@ -424,12 +424,12 @@ std::vector<SceneKey> declare_scene_keys() {
                             "step after the velocity update (0: off; needs `method = \"dfsph\"`); docs/sph.md",
                      .unhashed_value = "0"},
             in_sph(&sph::SphParameters::xsph)));
-  add(field(SceneKey{.key = "sph.surface_tension", .section = "sph", .unit = "see docs/sph.md", .range = kNonNegative,
-                     .doc = "γ of Akinci et al. 2013's surface tension (cohesion and curvature; 0: off; needs "
-                            "`method = \"dfsph\"`); docs/sph.md",
+  add(field(SceneKey{.key = "sph.surface_tension", .section = "sph", .range = kNonNegative,
+                     .doc = "γ of Akinci et al. 2013's surface tension (cohesion and curvature, in the paper's "
+                            "units; 0: off; needs `method = \"dfsph\"`); docs/sph.md",
                      .unhashed_value = "0"},
             in_sph(&sph::SphParameters::surface_tension)));
-  add(field(SceneKey{.key = "sph.adhesion", .section = "sph", .unit = "see docs/sph.md", .range = kNonNegative,
+  add(field(SceneKey{.key = "sph.adhesion", .section = "sph", .range = kNonNegative,
                      .doc = "β of Akinci et al. 2013's adhesion of the fluid to boundary particles (0: off; needs "
                             "`method = \"dfsph\"` and boundary particles); docs/sph.md",
                      .unhashed_value = "0"},
