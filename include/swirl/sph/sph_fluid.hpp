@@ -585,6 +585,7 @@ class SphFluid final : public Solver<Real> {
   // scratch), in all: add to the particle fields for the memory per particle.
   std::size_t scratch_bytes() const override {
     return grid_.bytes() + scratch_.bytes() + alpha_.capacity() * sizeof(Real) +
+           (normals_[0].capacity() + normals_[1].capacity() + normals_[2].capacity()) * sizeof(Real) +
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
            lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
