@@ -434,6 +434,22 @@ std::vector<SceneKey> declare_scene_keys() {
             in_sph(&sph::SphParameters::sound_speed)));
   add(field(SceneKey{.key = "sph.viscosity", .section = "sph", .unit = "Pa·s", .range = kNonNegative, .doc = "μ"},
             in_sph(&sph::SphParameters::viscosity)));
+  // DFSPH's non-pressure terms: keys added after checkpoints existed, left out of the hash when off.
+  add(field(SceneKey{.key = "sph.xsph", .section = "sph", .range = kUnit,
+                     .doc = "ε of the XSPH velocity filter v_i += ε Σ_j 2m_j/(ρ_i + ρ_j)·(v_j − v_i)·W_ij, once per "
+                            "step after the velocity update (0: off; needs `method = \"dfsph\"`); docs/sph.md",
+                     .unhashed_value = "0"},
+            in_sph(&sph::SphParameters::xsph)));
+  add(field(SceneKey{.key = "sph.surface_tension", .section = "sph", .range = kNonNegative,
+                     .doc = "γ of Akinci et al. 2013's surface tension (cohesion and curvature, in the paper's "
+                            "units; 0: off; needs `method = \"dfsph\"`); docs/sph.md",
+                     .unhashed_value = "0"},
+            in_sph(&sph::SphParameters::surface_tension)));
+  add(field(SceneKey{.key = "sph.adhesion", .section = "sph", .range = kNonNegative,
+                     .doc = "β of Akinci et al. 2013's adhesion of the fluid to boundary particles (0: off; needs "
+                            "`method = \"dfsph\"` and boundary particles); docs/sph.md",
+                     .unhashed_value = "0"},
+            in_sph(&sph::SphParameters::adhesion)));
   add(field(SceneKey{.key = "sph.gradient_correction", .section = "sph",
                      .doc = "corrects the pressure force by M_i⁻¹ (Bonet & Lok's kernel-gradient renormalisation: exact "
                             "for a linear pressure field; not momentum-conserving; off where det M_i < 0.5, as at a "

@@ -101,10 +101,19 @@ class Checker {
         fail("sph.gradient_correction", "corrects the thesis's pressure force, which \"dfsph\" does not use");
       if (s_.time_steps == TimeSteps::Block)
         fail("simulation.time_steps", "\"block\" cannot be combined with sph.method = \"dfsph\"");
-    } else if (f.kernel != sph::SphKernel::Thesis) {
-      fail("sph.kernel", fmt::format("\"{}\" needs sph.method = \"dfsph\" (the thesis's solver runs its own kernels)",
-                                     enum_name<sph::SphKernel>(sph::kSphKernelNames, f.kernel)));
+    } else {
+      if (f.kernel != sph::SphKernel::Thesis)
+        fail("sph.kernel", fmt::format("\"{}\" needs sph.method = \"dfsph\" (the thesis's solver runs its own kernels)",
+                                       enum_name<sph::SphKernel>(sph::kSphKernelNames, f.kernel)));
+      for (const auto& [key, value] : {std::pair{"sph.xsph", f.xsph}, std::pair{"sph.surface_tension", f.surface_tension},
+                                       std::pair{"sph.adhesion", f.adhesion}})
+        if (value > 0)
+          fail(key, fmt::format("{:g} needs sph.method = \"dfsph\" (the thesis's solver has no such term yet)", value));
     }
+    if (f.adhesion > 0 && !s_.has_boundary_particles())
+      fail("sph.adhesion", fmt::format("{:g} acts between the fluid and boundary particles, and the scene has none "
+                                       "(box.walls = \"particles\" or an obstacle)",
+                                       f.adhesion));
     const double keys = dense_cell_table_keys(s_);
     if (keys > 0x1p31)
       fail("sph.grid.table",

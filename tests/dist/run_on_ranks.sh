@@ -120,6 +120,17 @@ on_ranks 2 run --resume "$dir" --steps 15 --checkpoint-every-steps 10
 for f in particles_000003.vtp diagnostics.csv checkpoints/checkpoint_000000000030.swc; do
   cmp -s "$out/dfsph_1/$f" "$dir/$f" || fail "dfsph resume 3 -> 2 ranks: $f differs from the uninterrupted one-rank run"
 done
+# 4c. The same with DFSPH's XSPH filter, surface tension and adhesion on
+#     (docs/sph.md): the ghosts' velocities, densities and surface normals
+#     refreshed; 3 ranks against one, and the terms did change the run.
+terms=("${obstacle[@]}" --set sph.xsph=0.1 --set sph.surface_tension=0.5 --set sph.adhesion=2)
+on_ranks 1 run "${terms[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/terms_1"
+[ "$status" -eq 0 ] || { fail "dfsph with xsph, surface tension, adhesion on 1 rank: status $status"; cat "$out/stderr"; }
+on_ranks 3 run "${terms[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/terms_3"
+[ "$status" -eq 0 ] || { fail "dfsph with xsph, surface tension, adhesion on 3 ranks: status $status"; cat "$out/stderr"; }
+same_files "$out/terms_1" "$out/terms_3" "dfsph with xsph, surface tension and adhesion on 3 ranks"
+cmp -s "$out/dfsph_1/particles_000003.vtp" "$out/terms_1/particles_000003.vtp" &&
+  fail "dfsph: sph.xsph, sph.surface_tension and sph.adhesion changed nothing"
 walls=("$scene" "${small[@]}" --set 'box.walls="particles"' --steps 30 --checkpoint-every-steps 10)
 on_ranks 1 run "${walls[@]}" --out "$out/walls_1"
 [ "$status" -eq 0 ] || { fail "walls of particles on 1 rank: status $status"; cat "$out/stderr"; }

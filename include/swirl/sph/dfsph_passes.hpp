@@ -21,6 +21,11 @@
 //   dfsph_add_viscosity        a_i += μ/ρ_i Σ_j V_j (v_j − v_i) ∇²W_visc(r_ij),
 //                              the thesis's viscosity term (eq. 2.10) as the
 //                              non-pressure force
+//   dfsph_xsph_change          Δv_i = ε Σ_j 2m_j/(ρ_i + ρ_j) (v_j − v_i) W_ij,
+//                              the XSPH filter (sph.xsph), fluid j only
+//   dfsph_surface_normals      n_i = h Σ_j (m_j/ρ_j) ∇W_ij (Akinci et al. 2013)
+//   dfsph_add_surface_forces   Akinci et al. 2013's cohesion, curvature and
+//                              adhesion (sph.surface_tension, sph.adhesion)
 //
 // Boundary particles (Akinci et al. 2012; core/particle_kind.hpp): with a
 // `kind` array (null: all fluid), a boundary particle b carries its volume
@@ -59,6 +64,7 @@
 #include "swirl/spatial/distance.hpp"
 #include "swirl/sph/dfsph_pairs.hpp"
 #include "swirl/sph/grid_passes.hpp"
+#include "swirl/sph/kernels.hpp"
 #include "swirl/sph/laws.hpp"
 
 namespace swirl::sph {
@@ -240,6 +246,114 @@ void dfsph_add_viscosity(const spatial::SortedCellGrid<Real>& grid, ParticleSet<
       ax[i] += f * sx;
       ay[i] += f * sy;
       az[i] += f * sz;
+    });
+  });
+}
+
+// XSPH's velocity change (Monaghan 1989's filter, symmetrised):
+//   Δv_i = ε Σ_j 2 m_j / (ρ_i + ρ_j) · (v_j − v_i) W_ij       (fluid j only)
+// into dv[0..2][i] (0 for a boundary particle). Its pair terms times m_i are
+// antisymmetric, so Σ_i m_i Δv_i = 0: applied to every particle at once (the
+// caller adds dv after the pass) it conserves linear momentum to rounding.
+template <class Real>
+void dfsph_xsph_change(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& p,
+                       const DfsphKernel<Real>& kernel, std::size_t block_size, Real epsilon, Real* const dv[3],
+                       const std::int32_t* kind = nullptr, IndexRange only = detail::kAllParticles) {
+  const IndexRange range = detail::pass_range(only, p.size());
+  const std::size_t from = range.begin;
+  const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
+  const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data(), *rho = p.density.data();
+  parallel::for_blocks_pinned("dfsph_xsph", range.end - range.begin, block_size,
+                              [&](std::size_t b, std::size_t e, std::size_t) {
+    const DfsphKernel<Real> k = kernel;
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
+      Real sx = 0, sy = 0, sz = 0;
+      if (!kind || !is_boundary(kind[i]))
+        detail::for_each_pair(x, y, z, i, ranges, count, k.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (kind && is_boundary(kind[j])) return;
+          const Real t = Real(2) * m[j] / (rho[i] + rho[j]) * k.w(r2, std::sqrt(r2));
+          sx += t * (vx[j] - vx[i]), sy += t * (vy[j] - vy[i]), sz += t * (vz[j] - vz[i]);
+        });
+      dv[0][i] = epsilon * sx;
+      dv[1][i] = epsilon * sy;
+      dv[2][i] = epsilon * sz;
+    });
+  });
+}
+
+// Akinci et al. 2013's surface normals (eq. 4), dimensionless:
+//   n_i = h Σ_j (m_j/ρ_j) ∇W_ij      (fluid j only; 0 for a boundary particle)
+// |n| grows from 0 inside the fluid to about 1 at a free surface, pointing out.
+template <class Real>
+void dfsph_surface_normals(const spatial::SortedCellGrid<Real>& grid, const ParticleSet<Real>& p,
+                           const DfsphKernel<Real>& kernel, std::size_t block_size, Real* const n[3],
+                           const std::int32_t* kind = nullptr, IndexRange only = detail::kAllParticles) {
+  const IndexRange range = detail::pass_range(only, p.size());
+  const std::size_t from = range.begin;
+  const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
+  const Real* rho = p.density.data();
+  parallel::for_blocks_pinned("dfsph_normals", range.end - range.begin, block_size,
+                              [&](std::size_t b, std::size_t e, std::size_t) {
+    const DfsphKernel<Real> k = kernel;
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
+      Real sx = 0, sy = 0, sz = 0;
+      if (!kind || !is_boundary(kind[i]))
+        detail::for_each_pair(x, y, z, i, ranges, count, k.h2, [&](std::size_t j, Real dx, Real dy, Real dz, Real r2) {
+          if (kind && is_boundary(kind[j])) return;
+          const Real g = m[j] / rho[j] * k.gradient(std::sqrt(r2));
+          sx += g * dx, sy += g * dy, sz += g * dz;
+        });
+      n[0][i] = k.h * sx;
+      n[1][i] = k.h * sy;
+      n[2][i] = k.h * sz;
+    });
+  });
+}
+
+// Akinci et al. 2013's surface tension and adhesion as accelerations, added
+// into a_i of every fluid particle (x̂_ij = r⃗_ij/r, r⃗_ij = x_i − x_j):
+//   fluid j ≠ i:  a_i += −γ K_ij (m_j C(r) x̂_ij + (n_i − n_j)),  K_ij = 2ρ0/(ρ_i + ρ_j)   (eq. 1–5)
+//   boundary b:   a_i += −β ψ_b A(r) x̂_ib                                                (eq. 6)
+// C, A: sph/kernels.hpp's Akinci splines; n: dfsph_surface_normals(); ψ_b:
+// the boundary particle's volume weight ρ0 V_b (its mass field). The pair
+// terms times m_i are antisymmetric between fluid particles.
+template <class Real>
+void dfsph_add_surface_forces(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
+                              const DfsphKernel<Real>& kernel, std::size_t block_size, Real gamma, Real beta,
+                              Real rest_density, const Real* const n[3], const std::int32_t* kind = nullptr,
+                              IndexRange only = detail::kAllParticles) {
+  const IndexRange range = detail::pass_range(only, p.size());
+  const std::size_t from = range.begin;
+  const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
+  const Real* rho = p.density.data();
+  Real *ax = p.acceleration.x.data(), *ay = p.acceleration.y.data(), *az = p.acceleration.z.data();
+  const Real *nx = n[0], *ny = n[1], *nz = n[2];
+  const AkinciCohesion<Real> cohesion(kernel.h);
+  const AkinciAdhesion<Real> adhesion(kernel.h);
+  parallel::for_blocks_pinned("dfsph_surface", range.end - range.begin, block_size,
+                              [&](std::size_t b, std::size_t e, std::size_t) {
+    const Real h2 = kernel.h2, two_rho0 = Real(2) * rest_density;
+    detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
+      if (kind && is_boundary(kind[i])) return;  // static: its acceleration is zeroed anyway
+      Real sx = 0, sy = 0, sz = 0;  // Σ over fluid j of K_ij (…), times −γ below
+      Real tx = 0, ty = 0, tz = 0;  // Σ over boundary b of ψ_b A(r) x̂, times −β below
+      detail::for_each_pair(x, y, z, i, ranges, count, h2, [&](std::size_t j, Real dx, Real dy, Real dz, Real r2) {
+        if (j == i) return;
+        const Real r = std::sqrt(r2), inv_r = r > Real(0) ? Real(1) / r : Real(0);
+        if (kind && is_boundary(kind[j])) {
+          const Real t = m[j] * adhesion(r) * inv_r;
+          tx += t * dx, ty += t * dy, tz += t * dz;
+          return;
+        }
+        if (gamma == Real(0)) return;  // adhesion only: n is not computed
+        const Real K = two_rho0 / (rho[i] + rho[j]), c = m[j] * cohesion(r) * inv_r;
+        sx += K * (c * dx + (nx[i] - nx[j]));
+        sy += K * (c * dy + (ny[i] - ny[j]));
+        sz += K * (c * dz + (nz[i] - nz[j]));
+      });
+      ax[i] -= gamma * sx + beta * tx;
+      ay[i] -= gamma * sy + beta * ty;
+      az[i] -= gamma * sz + beta * tz;
     });
   });
 }

@@ -7,7 +7,7 @@
 // Between steps, as every stepper keeps it: x, v belong to one time; ρ and
 // α (the fluid's evaluation at x) and a = a_np, the non-pressure acceleration
 // (every solver's, gravity included, plus the fluid's viscosity from the final
-// v). One step of Δt:
+// v, surface tension and adhesion). One step of Δt:
 //   1. v* = v + Δt·a_np
 //   2. constant-density solve (2017, Algorithm 3), on the grid at x:
 //        warm start: κ_i ← ½ κ_i, the κ the last step ended with (field
@@ -26,7 +26,11 @@
 //   5. divergence-free solve (2017, Algorithm 2), the same with
 //        error = mean_i max((Dρ/Dt)_i, 0)·Δt/ρ0 ≤ η_v (at least 1 iteration),
 //        Δκ^v_i = (Dρ/Dt)_i/Δt · α_i, warm-started from "dfsph_kappa_v"
-//   6. a_np += the fluid's viscosity from the final v; the scan.
+//   6. XSPH (sph.xsph = ε > 0): v ← v + Δv of the filter, once, on the final
+//      v (the grid and ρ of step 4; sph/dfsph_passes.hpp, dfsph_xsph_change);
+//      it is the step's last change of v, so frames see the filtered velocity
+//   7. a_np += the fluid's viscosity from the final v, and surface tension and
+//      adhesion (Akinci et al. 2013) at the new x; the scan.
 // Each iteration's Δκ is clamped at 0 (only compression is corrected: the
 // papers' ρ* ← max(ρ*, ρ0), no tension at the free surface), and the errors
 // count compression only, so an under-dense surface particle is no error. A
@@ -114,7 +118,7 @@ class DfsphStepper final : public integrate::Stepper<Real> {
 
   void start(ParticleSet<Real>& p, integrate::Forces& forces, double time, std::size_t block_size) override {
     forces.evaluate(time);
-    fluid_.add_viscosity(p, block_size);
+    fluid_.add_non_pressure(p, block_size);
   }
 
   integrate::StepOutcome advance(ParticleSet<Real>& p, integrate::Forces& forces,
@@ -127,7 +131,7 @@ class DfsphStepper final : public integrate::Stepper<Real> {
       const auto tally = fluid_.tally();
       forces.evaluate(r.t_next - r.dt);
       fluid_.set_tally(tally);
-      fluid_.add_viscosity(p, bs);
+      fluid_.add_non_pressure(p, bs);
       refresh_ = false;
     }
     integrate::StepOutcome out;
@@ -165,7 +169,8 @@ class DfsphStepper final : public integrate::Stepper<Real> {
       if (r.timers) phase.emplace(*r.timers, "dfsph.divergence");
       last_divergence_ = solve(p, dt, bs, Solve::Divergence);
     }
-    fluid_.add_viscosity(p, bs);
+    fluid_.apply_xsph(p, bs);
+    fluid_.add_non_pressure(p, bs);
     record();
     for (const auto& [s, what, tolerance, unit] :
          {std::tuple{&last_density_, "constant-density", fluid_.parameters().dfsph.density_tolerance, "average compression"},

@@ -1,8 +1,11 @@
 // The smoothing kernels of Müller et al. 2003, as the thesis uses them
-// (section 2.1.1), and the cubic spline of Monaghan 1992 (DFSPH's kernel). Each is a small evaluator built once for a support radius h
-// (m); all vanish for r ≥ h. Units: W in 1/m³, ∇W in 1/m⁴, ∇²W in 1/m⁵.
+// (section 2.1.1), the cubic spline of Monaghan 1992 (DFSPH's kernel), and
+// the cohesion and adhesion splines of Akinci et al. 2013 (surface tension).
+// Each is a small evaluator built once for a support radius h (m); all vanish
+// for r ≥ h. Units: W in 1/m³, ∇W in 1/m⁴, ∇²W in 1/m⁵; the splines' below.
 #pragma once
 
+#include <cmath>
 #include <numbers>
 
 namespace swirl::sph {
@@ -119,6 +122,47 @@ struct CubicSpline {
   }
 
   Real h, inv_h, norm, grad_norm;
+};
+
+// The cohesion spline of Akinci, Akinci & Teschner 2013 ("Versatile surface
+// tension and adhesion for SPH fluids", eq. 2), support h (1/m³):
+//   C(r) = 32/(π h⁹) · (h − r)³ r³                for h/2 < r < h
+//        = 32/(π h⁹) · (2 (h − r)³ r³ − h⁶/64)    for 0 < r ≤ h/2
+// Positive (attraction) beyond about 0.3 h, negative (repulsion) closer in,
+// so that cohesion alone does not clump particles; 0 at r = 0 and r ≥ h.
+template <class Real>
+struct AkinciCohesion {
+  explicit AkinciCohesion(Real h_)
+      : h(h_), norm(Real(32) / (std::numbers::pi_v<Real> * pow9(h_))), h6_64(pow6(h_) / Real(64)) {}
+
+  Real operator()(Real r) const {
+    if (r >= h || r <= Real(0)) return Real(0);
+    const Real d = h - r, t = d * d * d * r * r * r;
+    return Real(2) * r > h ? norm * t : norm * (Real(2) * t - h6_64);
+  }
+
+  Real h, norm, h6_64;
+
+ private:
+  static Real pow6(Real x) { const Real x3 = x * x * x; return x3 * x3; }
+  static Real pow9(Real x) { const Real x3 = x * x * x; return x3 * x3 * x3; }
+};
+
+// The adhesion spline of Akinci et al. 2013 (eq. 7), support h (1/m³):
+//   A(r) = 0.007 / h^3.25 · (−4r²/h + 6r − 2h)^¼   for h/2 < r < h, else 0
+// (0 at both ends, largest at r = ¾h): a fluid particle is drawn towards a
+// boundary particle between half a support and a support away.
+template <class Real>
+struct AkinciAdhesion {
+  explicit AkinciAdhesion(Real h_) : h(h_), norm(Real(0.007) / Real(std::pow(double(h_), 3.25))) {}
+
+  Real operator()(Real r) const {
+    if (r >= h || Real(2) * r <= h) return Real(0);
+    const Real base = -Real(4) * r * r / h + Real(6) * r - Real(2) * h;
+    return base > Real(0) ? norm * std::sqrt(std::sqrt(base)) : Real(0);
+  }
+
+  Real h, norm;
 };
 
 }  // namespace swirl::sph

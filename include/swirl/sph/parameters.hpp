@@ -84,6 +84,10 @@ struct SphParameters {
   SphMethod method = SphMethod::Wcsph;
   SphKernel kernel = SphKernel::Thesis;  // DFSPH's kernels (the thesis's solver always uses its own set)
   DfsphOptions dfsph;                    // method = Dfsph only
+  // Non-pressure terms of DFSPH (sph_fluid.hpp, docs/sph.md; 0 = off):
+  double xsph = 0;             // ε of the XSPH velocity filter, dimensionless, in [0, 1]
+  double surface_tension = 0;  // γ of Akinci et al. 2013's cohesion and curvature (≥ 0; see sph_fluid.hpp for units)
+  double adhesion = 0;         // β of Akinci et al. 2013's fluid–boundary adhesion (≥ 0)
 };
 
 // The thesis's table size for n particles: 1.6·n, odd (24001 for 15000).

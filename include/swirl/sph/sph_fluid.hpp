@@ -60,6 +60,13 @@
 // stay put. Its warm starts are two internal particle fields (kKappaField,
 // kKappaVField), so reorders and checkpoints carry them. Its time-step
 // condition is a CFL without a sound speed: Δt ≤ C·h/|v|max (sph.dfsph.cfl).
+// DFSPH's non-pressure terms beyond the viscosity (docs/sph.md; 0 = off):
+// the XSPH velocity filter (sph.xsph = ε, apply_xsph(), once per step on the
+// final velocities), and Akinci et al. 2013's surface tension (sph.surface_
+// tension = γ: cohesion and curvature from the normals n_i = h Σ_j (m_j/ρ_j)
+// ∇W_ij) and adhesion to boundary particles (sph.adhesion = β), accelerations
+// added with the viscosity (add_non_pressure()); sph/dfsph_passes.hpp has
+// the formulas. The thesis's solver refuses them.
 //
 // Boundary particles (Akinci et al. 2012, "Versatile rigid-fluid coupling for
 // incompressible SPH"; core/particle_kind.hpp): when the particle set has the
@@ -172,6 +179,14 @@ class SphFluid final : public Solver<Real> {
       throw std::invalid_argument("SPH: sph.method = \"dfsph\" needs sph.neighbour_search = \"grid\"");
     if (!dfsph() && params.kernel != SphKernel::Thesis)
       throw std::invalid_argument("SPH: sph.kernel = \"cubic_spline\" needs sph.method = \"dfsph\"");
+    if (!(params.xsph >= 0 && params.xsph <= 1)) throw std::invalid_argument("SPH: sph.xsph must be in [0, 1]");
+    if (!(params.surface_tension >= 0) || !std::isfinite(params.surface_tension))
+      throw std::invalid_argument("SPH: sph.surface_tension must be finite and ≥ 0");
+    if (!(params.adhesion >= 0) || !std::isfinite(params.adhesion))
+      throw std::invalid_argument("SPH: sph.adhesion must be finite and ≥ 0");
+    if (!dfsph() && (params.xsph > 0 || params.surface_tension > 0 || params.adhesion > 0))
+      throw std::invalid_argument(
+          "SPH: sph.xsph, sph.surface_tension and sph.adhesion need sph.method = \"dfsph\"");
   }
 
   // DFSPH's warm starts: the κ sums of the last constant-density and
@@ -303,6 +318,57 @@ class SphFluid final : public Solver<Real> {
     to_local(p.acceleration, local_.acceleration);
     dfsph_add_viscosity(grid_, local_, SphLaws<Real>(params_), block_size, kinds(local_), own_);
     from_local(local_.acceleration, p.acceleration);
+  }
+  // DFSPH's non-pressure acceleration of the fluid at the current state (x,
+  // ρ and the grid of the last evaluation, the current v), added into a: the
+  // viscosity, then surface tension and adhesion (Akinci et al. 2013,
+  // sph/dfsph_passes.hpp): one pass for the normals n_i (when γ > 0), one for
+  // the forces.
+  void add_non_pressure(ParticleSet<Real>& p, std::size_t block_size) {
+    add_viscosity(p, block_size);
+    const double gamma = params_.surface_tension, beta = params_.adhesion;
+    if (!(gamma > 0) && !(beta > 0)) return;
+    const Real rho0 = Real(params_.rest_density);
+    if (!ranks_) {
+      for (auto& a : normals_) a.assign(p.size(), Real(0));
+      Real* const n[3] = {normals_[0].data(), normals_[1].data(), normals_[2].data()};
+      if (gamma > 0) dfsph_surface_normals(grid_, p, *kernel_, block_size, n, kinds(p));
+      dfsph_add_surface_forces(grid_, p, *kernel_, block_size, Real(gamma), Real(beta), rho0, n, kinds(p));
+      return;
+    }
+    Real* const n[3] = {local_.extra(normal_field_, 0).data(), local_.extra(normal_field_, 1).data(),
+                        local_.extra(normal_field_, 2).data()};
+    if (gamma > 0) {
+      dfsph_surface_normals(grid_, local_, *kernel_, block_size, n, kinds(local_), own_);
+      halo_.refresh(ranks_->comm(), local_, {std::string(kLocalNormalField)});
+    }
+    to_local(p.acceleration, local_.acceleration);
+    dfsph_add_surface_forces(grid_, local_, *kernel_, block_size, Real(gamma), Real(beta), rho0, n, kinds(local_), own_);
+    from_local(local_.acceleration, p.acceleration);
+  }
+  // DFSPH's XSPH filter (sph.xsph = ε > 0), once per step on the final
+  // velocities: v_i += Δv_i of dfsph_xsph_change, all Δv from the velocities
+  // before (so momentum is conserved to rounding). Nothing when ε = 0.
+  void apply_xsph(ParticleSet<Real>& p, std::size_t block_size) {
+    const Real epsilon = Real(params_.xsph);
+    if (!(epsilon > 0)) return;
+    const ParticleSet<Real>& at = ranks_ ? local_ : p;
+    if (ranks_) {
+      to_local(p.velocity, local_.velocity);
+      halo_.refresh(ranks_->comm(), local_, {"velocity"});
+    }
+    for (auto& a : normals_) a.resize(at.size());  // scratch: Δv
+    Real* const dv[3] = {normals_[0].data(), normals_[1].data(), normals_[2].data()};
+    const IndexRange range = ranks_ ? own_ : detail::all_of(p);
+    dfsph_xsph_change(grid_, at, *kernel_, block_size, epsilon, dv, kinds(at), range);
+    parallel::for_blocks_pinned("dfsph_xsph_apply", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
+      for (int axis = 0; axis < 3; ++axis) {
+        Real* v = p.velocity[axis].data();
+        const Real* d = dv[axis] + range.begin;
+#pragma omp simd
+        for (std::size_t i = b; i < e; ++i) v[i] += d[i];
+      }
+    });
   }
   // True when the last evaluation ran on several ranks.
   bool on_ranks() const { return ranks_ != nullptr; }
@@ -536,6 +602,7 @@ class SphFluid final : public Solver<Real> {
   // scratch), in all: add to the particle fields for the memory per particle.
   std::size_t scratch_bytes() const override {
     return grid_.bytes() + scratch_.bytes() + alpha_.capacity() * sizeof(Real) + pairs_.bytes() +
+           (normals_[0].capacity() + normals_[1].capacity() + normals_[2].capacity()) * sizeof(Real) +
            lists_.row_particle.capacity() * sizeof(std::uint32_t) + lists_.offsets.capacity() * sizeof(std::size_t) +
            lists_.neighbour.capacity() * sizeof(std::uint32_t) + lists_.r2.capacity() * sizeof(Real) +
            hash_.cells().capacity() * (2 * sizeof(spatial::Cell) + sizeof(std::uint32_t) + 3 * sizeof(Real)) +
@@ -791,6 +858,8 @@ class SphFluid final : public Solver<Real> {
         std::copy_n(kind, n, local_.int_field(k).data());
       }
       kr_field_ = local_.add_field(std::string(kLocalKappaField), 1, FieldUse::Internal);
+      if (params_.surface_tension > 0 || params_.adhesion > 0)
+        normal_field_ = local_.add_field(std::string(kLocalNormalField), 3, FieldUse::Internal);
       halo_keys_.assign(order.keys().begin(), order.keys().end());
       halo_ = dist::Halo::find(comm, order.frame(), halo_keys_, order.first_global_index(), order.global_count(),
                                order.cut_keys(), kHaloTail<Real>);
@@ -825,7 +894,9 @@ class SphFluid final : public Solver<Real> {
       pairs = dfsph_density_and_factor(grid_, local_, *kernel_, ctx.block_size, alpha_.data(), Real(alpha_cap_), kind,
                                        Real(params_.rest_density), own_, &pairs_);
       std::copy_n(local_.density.data() + own_.begin, n, p.density.data());
-      if (params_.viscosity > 0) halo_.refresh(comm, local_, {"density"});  // the viscosity's V_j = m_j/ρ_j
+      // The ghosts' ρ: the viscosity's V_j = m_j/ρ_j, XSPH's and surface tension's ρ_j.
+      if (params_.viscosity > 0 || params_.xsph > 0 || params_.surface_tension > 0)
+        halo_.refresh(comm, local_, {"density"});
     }
     const std::uint64_t all = comm.sum(pairs);
     const std::size_t fluid = fluid_count(p);
@@ -980,6 +1051,9 @@ class SphFluid final : public Solver<Real> {
   std::size_t kr_field_ = 0;
   AlignedVector<Real> local_out_;
   static constexpr std::string_view kLocalKappaField = "dfsph_k_over_rho";
+  std::size_t normal_field_ = 0;  // Akinci's normals n_i in local_ (surface tension or adhesion on)
+  static constexpr std::string_view kLocalNormalField = "dfsph_surface_normal";
+  std::array<AlignedVector<Real>, 3> normals_;  // one rank: the normals n_i; XSPH's Δv (scratch)
   double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
   static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
