@@ -31,7 +31,8 @@ sim_threads_test sim_adaptive_test sph_sph_fluid_test sph_grid_strategy_test
 gravity_schemes_test gravity_direct_sum_test gravity_diagnostics_test gravity_bench_test gravity_linear_tree_test
 render_splats_test render_surface_density_test render_run_renderer_test io_atomic_file_test
 sph_grid_skin_test sph_grid_dispatch_test gravity_group_walk_test gravity_block_steps_test
-gravity_fmm_test sim_dfsph_test view_live_session_test view_replay_test view_mesher_test"
+gravity_fmm_test sim_dfsph_test view_live_session_test view_replay_test view_mesher_test
+sph_dfsph_pairs_test sph_dfsph_surface_test"
 # shellcheck disable=SC2206 # a list of target names, split on white space
 TARGETS=(${SWIRL_TSAN_TARGETS:-$DEFAULT_TARGETS})
 start=$SECONDS
