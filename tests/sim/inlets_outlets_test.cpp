@@ -28,6 +28,7 @@
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/inlets_outlets.hpp"
 #include "swirl/sim/run.hpp"
+#include "swirl/sph/sph_fluid.hpp"
 
 namespace {
 
@@ -158,6 +159,37 @@ TEST(Inlets, ALayerLeavesEverySpacingOverSpeedWithFreshIdsAndTheFluidsMass) {
     }
   }
   EXPECT_NEAR(mass, double(p.size()) * block_mass, 1e-12 * mass);
+}
+
+// With boundary particles (a kind field) the fluid's count is what DFSPH's
+// average errors divide by: it must follow the particles the inlet adds (it
+// was once counted at the first evaluation only, so a fluid poured in was
+// averaged over the fluid the run started with).
+TEST(Inlets, TheFluidCountFollowsTheParticlesAdded) {
+  std::string text = tank("", 40);
+  text.replace(text.find("[box]\n"), 6, "[box]\nwalls = \"particles\"\n");
+  const scene::Scene s = scene::parse_scene(text, "scene.toml");
+  Simulation<double> sim = sim::build_simulation<double>(s);
+  sim.start();
+  sim::InletsAndOutlets<double> inlets(s);
+  inlets.on_start(sim, false);
+  const auto* fluid = sim.find_solver<sph::SphFluid<double>>();
+  ASSERT_NE(fluid, nullptr);
+  const auto fluid_now = [&] {
+    std::size_t n = 0;
+    const auto& p = sim.particles();
+    const auto& kind = p.int_field(p.find_int_field(kKindField));
+    for (std::size_t i = 0; i < p.size(); ++i) n += is_boundary(kind[i]) ? 0 : 1;
+    return n;
+  };
+  EXPECT_EQ(fluid->fluid_count(sim.particles()), fluid_now());
+  for (int k = 0; k < 40; ++k) {
+    sim.step();
+    inlets.on_step(sim);
+  }
+  ASSERT_GT(inlets.emitted(), 0u);
+  EXPECT_EQ(fluid->fluid_count(sim.particles()), fluid_now());
+  EXPECT_EQ(fluid_now(), 200u + inlets.emitted());
 }
 
 TEST(Outlets, RemoveEveryFluidParticleInsideAndNothingElse) {

@@ -638,11 +638,10 @@ class SphFluid final : public Solver<Real> {
                         dist::Halo* halo = nullptr) {
     const std::int32_t* kind = kinds(p);
     if (!kind) return false;
-    if (!counted_) {
-      const std::size_t mine = count_fluid(p, own);
-      fluid_count_ = ranks_ ? static_cast<std::size_t>(ranks_->comm().sum(std::uint64_t{mine})) : mine;
-      counted_ = true;
-    }
+    // Counted at every evaluation: inlets and outlets change the fluid count
+    // (sim/inlets_outlets.hpp), and the solves' average errors divide by it.
+    const std::size_t mine = count_fluid(p, own);
+    fluid_count_ = ranks_ ? static_cast<std::size_t>(ranks_->comm().sum(std::uint64_t{mine})) : mine;
     if (boundary_volumes_ && !moving_boundaries_) return false;
     const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
     Real* m = p.mass.data();
@@ -1067,8 +1066,7 @@ class SphFluid final : public Solver<Real> {
   bool moving_boundaries_ = false;  // ψ_b recomputed at every evaluation (set_moving_boundaries)
   bool record_reactions_ = false;  // DFSPH: record_density_reaction() after each density solve
   std::vector<double> density_reaction_;  // DFSPH: its result, 3 per id (scratch: a step recomputes it)
-  bool counted_ = false;           // fluid_count_ set
-  std::size_t fluid_count_ = 0;    // fluid particles (static: boundary particles are never added or removed)
+  std::size_t fluid_count_ = 0;    // fluid particles at the last evaluation (of all ranks)
 };
 
 }  // namespace swirl::sph
