@@ -15,7 +15,9 @@
 //
 // Layout: for each particle i of the pass's range that is not a boundary
 // particle, its neighbours j ≠ i with r_ij < h, in the grid's candidate
-// order, as {j, m_j ∇W_ij} (16 B a pair in float, 32 in double). The lists
+// order, as {j, ∇W's radial factor g(r_ij), r⃗_ij} (20 B a pair in float, 40 in
+// double): the very values the grid passes compute, so the passes here
+// evaluate the same expressions on the same operands. The lists
 // of the particles of one block of the pass (block_size consecutive
 // particles, the blocks of parallel::for_blocks_pinned) are one vector,
 // filled and read by the block's own thread. A boundary particle has an
@@ -25,10 +27,12 @@
 // that filled it, for the same range and block_size (the solve passes check
 // both and throw std::logic_error otherwise). The sums go over each list in
 // order, so the results are the same for any thread count, and for any rank
-// count (the candidate order is the global key order). They differ from the
-// grid passes' only by rounding (the gradient vector is rounded once as
-// stored): tests/sph/dfsph_pairs_test.cpp holds them to it.
-// Units: as dfsph_passes.hpp (m_j ∇W_ij in kg/m⁴).
+// count (the candidate order is the global key order), and they are the grid
+// passes' bits (tests/sph/dfsph_pairs_test.cpp): keeping m_j ∇W_ij as one
+// rounded vector (16 B) was tried first and changed results by rounding, which
+// a DFSPH solve's stopping test turns into other iteration counts (the
+// hydrostatic tank's pressure line moved from within 1 % to 1.9 %).
+// Units: as dfsph_passes.hpp (g in 1/m⁵, r⃗ in m).
 #pragma once
 
 #include <cstddef>
@@ -48,7 +52,8 @@ class DfsphPairs {
  public:
   struct Pair {
     std::uint32_t j;
-    Real gx, gy, gz;  // m_j ∇W_ij
+    Real g;           // the kernel gradient's radial factor: ∇W_ij = g·r⃗_ij
+    Real dx, dy, dz;  // r⃗_ij = x_i − x_j
   };
 
   // Makes room for the lists of `range` in blocks of block_size (keeping the
@@ -115,7 +120,7 @@ void dfsph_density_change(const DfsphPairs<Real>& pairs, const ParticleSet<Real>
                           const std::int32_t* kind, IndexRange range) {
   pairs.check(range, block_size);
   const std::size_t from = range.begin;
-  const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
+  const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data(), *m = p.mass.data();
   parallel::for_blocks_pinned("dfsph_density_change", range.end - range.begin, block_size,
                               [&](std::size_t b, std::size_t e, std::size_t) {
     for (std::size_t k = b; k < e; ++k) {
@@ -124,10 +129,12 @@ void dfsph_density_change(const DfsphPairs<Real>& pairs, const ParticleSet<Real>
         out[i] = 0;
         continue;
       }
-      const Real vxi = vx[i], vyi = vy[i], vzi = vz[i];
       Real sum = 0;
-      for (const auto* q = pairs.begin(k), *last = pairs.end(k); q != last; ++q)
-        sum += q->gx * (vxi - vx[q->j]) + q->gy * (vyi - vy[q->j]) + q->gz * (vzi - vz[q->j]);
+      for (const auto* q = pairs.begin(k), *last = pairs.end(k); q != last; ++q) {
+        const std::size_t j = q->j;
+        const Real g = m[j] * q->g;  // as the grid pass: m_j ∇W_ij = g · r⃗_ij
+        sum += g * ((vx[i] - vx[j]) * q->dx + (vy[i] - vy[j]) * q->dy + (vz[i] - vz[j]) * q->dz);
+      }
       out[i] = sum;
     }
   });
@@ -142,6 +149,7 @@ void dfsph_pressure_velocity(const DfsphPairs<Real>& pairs, ParticleSet<Real>& p
   pairs.check(range, block_size);
   const std::size_t from = range.begin;
   Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
+  const Real* m = p.mass.data();
   parallel::for_blocks_pinned("dfsph_pressure", range.end - range.begin, block_size,
                               [&](std::size_t b, std::size_t e, std::size_t) {
     for (std::size_t k = b; k < e; ++k) {
@@ -150,8 +158,9 @@ void dfsph_pressure_velocity(const DfsphPairs<Real>& pairs, ParticleSet<Real>& p
       const Real ki = k_over_rho[i];
       Real ax = 0, ay = 0, az = 0;
       for (const auto* q = pairs.begin(k), *last = pairs.end(k); q != last; ++q) {
-        const Real s = ki + k_over_rho[q->j];
-        ax += s * q->gx, ay += s * q->gy, az += s * q->gz;
+        const std::size_t j = q->j;
+        const Real g = m[j] * (ki + k_over_rho[j]) * q->g;  // as the grid pass
+        ax += g * q->dx, ay += g * q->dy, az += g * q->dz;
       }
       vx[i] -= dt * ax;
       vy[i] -= dt * ay;

@@ -146,10 +146,11 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
             const Real r = std::sqrt(r2);
             density += m[j] * k.w(r2, r);
             ++found;
-            const Real g = m[j] * k.gradient(r);  // m_j ∇W_ij = g · r⃗_ij (0 for j = i)
+            const Real gradient = k.gradient(r);
+            const Real g = m[j] * gradient;  // m_j ∇W_ij = g · r⃗_ij (0 for j = i)
             gx += g * dx, gy += g * dy, gz += g * dz;
             if (!kind || !is_boundary(kind[j])) g2 += g * g * r2;
-            if (list && j != i) list->push_back({static_cast<std::uint32_t>(j), g * dx, g * dy, g * dz});
+            if (list && j != i) list->push_back({static_cast<std::uint32_t>(j), gradient, dx, dy, dz});
           });
           if (list) keep->end_list(i - from, list->size());
           rho[i] = density;
