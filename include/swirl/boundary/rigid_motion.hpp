@@ -151,7 +151,10 @@ inline std::array<Vec3d, 2> swept_bounds(const RigidMotion& m, const Vec3d& x0) 
   const Vec3d a = m.axis * (1 / norm(m.axis)), r = x0 - m.point;
   const Vec3d centre = m.point + a * dot(r, a), u = r - a * dot(r, a);
   const Vec3d w{a.y * u.z - a.z * u.y, a.z * u.x - a.x * u.z, a.x * u.y - a.y * u.x};
-  const auto [lo_angle, hi_angle] = m.swept_angles();
+  // Plain variables, not a structured binding: clang (the TSan and fuzz
+  // builds) refuses to capture a binding in the lambdas below before C++20's P1091.
+  const auto swept = m.swept_angles();
+  const double lo_angle = swept[0], hi_angle = swept[1];
   Vec3d lo, hi;
   for (int k = 0; k < 3; ++k) {
     // Along axis k: centre_k + R cos(θ − θ*), R = |(u_k, w_k)|, θ* = atan2(w_k, u_k).
