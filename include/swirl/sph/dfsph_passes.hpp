@@ -99,6 +99,8 @@ inline IndexRange pass_range(IndexRange only, std::size_t n) {
 // particles of mass m (there Σ_j m_j ∇W_ij = 0): ρ0 / Σ_j |m ∇W_ij|², ρ0 = m/s³.
 template <class Real>
 double dfsph_lattice_factor(const DfsphKernel<Real>& kernel, double m, double s) {
+  // No fluid yet (a scene whose fluid comes from inlets): no lattice, no factor.
+  if (!(m > 0) || !(s > 0)) return 0.0;
   const int reach = static_cast<int>(std::ceil(double(kernel.h) / s));
   double sum = 0;
   for (int a = -reach; a <= reach; ++a)
