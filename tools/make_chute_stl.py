@@ -11,6 +11,8 @@ Usage: tools/make_chute_stl.py [OUT]   (default examples/chute.stl)
 import sys
 from pathlib import Path
 
+from ascii_stl import write_ascii_stl
+
 SIZE = (300, 200, 10)
 
 
@@ -28,29 +30,9 @@ def triangles():
     return out
 
 
-def normal(p, q, r):
-    u = [q[i] - p[i] for i in range(3)]
-    v = [r[i] - p[i] for i in range(3)]
-    n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
-    length = sum(c * c for c in n) ** 0.5
-    return [c / length + 0.0 for c in n]
-
-
 def main():
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parent.parent / "examples" / "chute.stl"
-    v = vertices()
-    lines = ["solid chute"]
-    for t in triangles():
-        n = normal(*(v[i] for i in t))
-        lines.append("  facet normal {:g} {:g} {:g}".format(*n))
-        lines.append("    outer loop")
-        for i in t:
-            lines.append("      vertex {:g} {:g} {:g}".format(*v[i]))
-        lines.append("    endloop")
-        lines.append("  endfacet")
-    lines.append("endsolid chute")
-    out.write_text("\n".join(lines) + "\n")
-    print(f"wrote {out}: {len(triangles())} triangles")
+    write_ascii_stl(out, "chute", vertices(), triangles())
 
 
 if __name__ == "__main__":

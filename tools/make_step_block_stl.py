@@ -13,6 +13,8 @@ Usage: tools/make_step_block_stl.py [OUT]   (default examples/step_block.stl)
 import sys
 from pathlib import Path
 
+from ascii_stl import write_ascii_stl
+
 PROFILE = [(0, 0), (240, 0), (240, 80), (120, 80), (120, 160), (0, 160)]
 WIDTH = 200
 
@@ -35,29 +37,9 @@ def triangles():
     return out
 
 
-def normal(p, q, r):
-    u = [q[i] - p[i] for i in range(3)]
-    v = [r[i] - p[i] for i in range(3)]
-    n = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
-    length = sum(c * c for c in n) ** 0.5
-    return [c / length + 0.0 for c in n]
-
-
 def main():
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parent.parent / "examples" / "step_block.stl"
-    v = vertices()
-    lines = ["solid step_block"]
-    for t in triangles():
-        n = normal(*(v[i] for i in t))
-        lines.append("  facet normal {:g} {:g} {:g}".format(*n))
-        lines.append("    outer loop")
-        for i in t:
-            lines.append("      vertex {:g} {:g} {:g}".format(*v[i]))
-        lines.append("    endloop")
-        lines.append("  endfacet")
-    lines.append("endsolid step_block")
-    out.write_text("\n".join(lines) + "\n")
-    print(f"wrote {out}: {len(triangles())} triangles")
+    write_ascii_stl(out, "step_block", vertices(), triangles())
 
 
 if __name__ == "__main__":

@@ -46,7 +46,7 @@ Diagnostics diagnose(const ParticleSet<Real>& p, std::size_t block_size) {
           part.k += 0.5 * m * dot(v, v);  // K = ½ Σ m |v|²
           part.w += 0.5 * m * phi[i];     // W = ½ Σ m φ
           part.p += m * v;                // P = Σ m v
-          part.l += m * Vec3d{x.y * v.z - x.z * v.y, x.z * v.x - x.x * v.z, x.x * v.y - x.y * v.x};  // L = Σ m x × v
+          part.l += m * cross(x, v);      // L = Σ m x × v
           part.mx += m * x;
         }
         return part;

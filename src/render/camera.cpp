@@ -11,10 +11,6 @@ namespace swirl::render {
 namespace {
 
 Vec3d normalized(const Vec3d& v) { return v * (1.0 / norm(v)); }
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 std::array<Vec3d, 8> corners(const Box<double>& b) {
   std::array<Vec3d, 8> c;
   for (int i = 0; i < 8; ++i) c[i] = {(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z};

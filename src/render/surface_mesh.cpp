@@ -17,10 +17,6 @@ namespace {
 
 constexpr int kSlabLayers = 4;  // node layers per work item of the field pass
 
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 // The 7 steps from a node to the other nodes of its cube: step s (1..7) is
 // (s & 1, s >> 1 & 1, s >> 2 & 1); a vertex on the edge (node, node + step s)
 // is bit s − 1 of the node's mask.

@@ -38,10 +38,6 @@ double mul_add(double a, double b, double c) {
   return a + bc;
 }
 
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 }  // namespace
 
 std::vector<Vec3d> placed_fill_vertices(const FluidFillSource& fill) { return placed_vertices(as_obstacle(fill)); }

@@ -36,10 +36,6 @@ std::uint64_t intervals(double length, double spacing) {
   return std::max<std::uint64_t>(1, static_cast<std::uint64_t>(std::ceil(r - r * 1e-12)));
 }
 
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
 using Edge = std::pair<std::uint32_t, std::uint32_t>;  // (lower index, higher)
 
 // The mesh's unique edges, in the order the triangles first name them.

@@ -178,21 +178,6 @@ std::vector<Vec3d> box_surface(const Box<double>& b, double spacing) {
   return out;
 }
 
-Vec3d cross(const Vec3d& a, const Vec3d& b) {
-  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-}
-
-// Two unit vectors u, v with (e, u, v) orthonormal, e a unit vector.
-std::pair<Vec3d, Vec3d> basis_around(const Vec3d& e) {
-  // The coordinate axis least aligned with e.
-  Vec3d other{1, 0, 0};
-  if (std::abs(e.y) <= std::abs(e.x) && std::abs(e.y) <= std::abs(e.z)) other = {0, 1, 0};
-  else if (std::abs(e.z) <= std::abs(e.x) && std::abs(e.z) <= std::abs(e.y)) other = {0, 0, 1};
-  Vec3d u = cross(e, other);
-  u = u * (1 / norm(u));
-  return {u, cross(e, u)};
-}
-
 // count points on the circle of radius r around c in the plane (u, v), from angle θ0.
 void ring(std::vector<Vec3d>& out, const Vec3d& c, const Vec3d& u, const Vec3d& v, double r, std::uint64_t count,
           double theta0) {

@@ -65,7 +65,7 @@ struct RigidMotion {
     Vec3d position(const Vec3d& x0) const { return pivot + rotated(x0) + shift; }
     Vec3d velocity(const Vec3d& x0) const {
       const Vec3d r = rotated(x0), w = angular_velocity;
-      return Vec3d{w.y * r.z - w.z * r.y, w.z * r.x - w.x * r.z, w.x * r.y - w.y * r.x} + shift_velocity;
+      return cross(w, r) + shift_velocity;
     }
   };
 
@@ -150,7 +150,7 @@ inline std::array<Vec3d, 2> swept_bounds(const RigidMotion& m, const Vec3d& x0) 
   // x(θ) = c + (r·â)â + cos θ·u + sin θ·(â × u), u = r − (r·â)â the radial part.
   const Vec3d a = m.axis * (1 / norm(m.axis)), r = x0 - m.point;
   const Vec3d centre = m.point + a * dot(r, a), u = r - a * dot(r, a);
-  const Vec3d w{a.y * u.z - a.z * u.y, a.z * u.x - a.x * u.z, a.x * u.y - a.y * u.x};
+  const Vec3d w = cross(a, u);
   // Plain variables, not a structured binding: clang (the TSan and fuzz
   // builds) refuses to capture a binding in the lambdas below before C++20's P1091.
   const auto swept = m.swept_angles();

@@ -22,7 +22,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
-#include <numeric>
 #include <span>
 #include <stdexcept>
 #include <vector>
@@ -104,33 +103,34 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
     if (b.size() % record != 0) throw std::runtime_error("distribute_in_key_order: a rank sent a partial record");
     count += b.size() / record;
   }
-  // Unpack in arrival order (source rank order), then sort by (key, previous global index).
+  // Unpack in arrival order (source rank order). Each source rank held a
+  // contiguous range of the previous order and sent its particles in that
+  // order, and the sources arrive in rank order: so the arrival order is the
+  // previous global order (checked as the records come), and the stable sort
+  // by key (the one-rank radix sort, parallel and linear) is the sort by
+  // (key, previous global index).
+  if (count > 0xffffffffu) throw std::invalid_argument("distribute_in_key_order: more than 2^32 - 1 particles on a rank");
   particles.resize(count);
   keys.resize(count);
-  std::vector<std::uint64_t> previous_index(count);
   auto get = [](const std::byte*& at, auto& value) {
     std::memcpy(&value, at, sizeof(value));
     at += sizeof(value);
   };
   std::size_t j = 0;
+  std::uint64_t previous = 0;
   for (const Bytes& b : received) {
     for (const std::byte* at = b.data(); at != b.data() + b.size(); ++j) {
+      std::uint64_t index = 0;
       get(at, keys[j]);
-      get(at, previous_index[j]);
+      get(at, index);
+      if (j > 0 && index <= previous)
+        throw std::logic_error("distribute_in_key_order: the ranks' particles were not in the global order");
+      previous = index;
       get(at, particles.id[j]);
       particles.for_each_array([&](AlignedVector<Real>& a) { get(at, a[j]); });
       particles.for_each_int_array([&](AlignedVector<Int>& a) { get(at, a[j]); });
     }
   }
-  // Each source rank held a contiguous range of the previous order and sent
-  // its particles in that order, and the sources arrive in rank order: so the
-  // arrival order is the previous global order, and the stable sort by key
-  // (the one-rank radix sort, parallel and linear) is the sort by (key,
-  // previous global index).
-  if (count > 0xffffffffu) throw std::invalid_argument("distribute_in_key_order: more than 2^32 - 1 particles on a rank");
-  for (std::size_t i = 1; i < count; ++i)
-    if (previous_index[i] <= previous_index[i - 1])
-      throw std::logic_error("distribute_in_key_order: the ranks' particles were not in the global order");
   parallel::RadixSort<std::uint64_t> sorter;
   sorter.sort(keys, 64);
   spatial::ParticleReorder<Real>().apply(particles, sorter.order(), kReorderBlock);

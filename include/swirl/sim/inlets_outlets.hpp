@@ -49,16 +49,7 @@ namespace swirl::sim {
 // fixed order (b outer, a inner, both ascending).
 inline std::vector<Vec3d> inlet_pattern(const scene::Inlet& inlet) {
   const Vec3d e = inlet.direction * (1 / norm(inlet.direction));
-  // u: e × the coordinate axis least aligned with e; v = e × u.
-  Vec3d other{1, 0, 0};
-  if (std::abs(e.y) <= std::abs(e.x) && std::abs(e.y) <= std::abs(e.z)) other = {0, 1, 0};
-  else if (std::abs(e.z) <= std::abs(e.x) && std::abs(e.z) <= std::abs(e.y)) other = {0, 0, 1};
-  const auto cross = [](const Vec3d& a, const Vec3d& b) {
-    return Vec3d{a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
-  };
-  Vec3d u = cross(e, other);
-  u = u * (1 / norm(u));
-  const Vec3d v = cross(e, u);
+  const auto [u, v] = basis_around(e);
   const double s = inlet.spacing, r2 = inlet.radius * inlet.radius;
   const auto reach = static_cast<std::int64_t>(std::floor(inlet.radius / s));
   std::vector<Vec3d> out;

@@ -1037,7 +1037,7 @@ class SphFluid final : public Solver<Real> {
   GridScratch<Real> scratch_;
   std::optional<DfsphKernel<Real>> kernel_;  // DFSPH: built at the first evaluation
   AlignedVector<Real> alpha_;                // DFSPH: α_i of the last evaluation
-  DfsphPairs<Real> pairs_;                   // DFSPH: its pairs with m_j ∇W_ij, for the solves' passes
+  DfsphPairs<Real> pairs_;                   // DFSPH: its pairs {j, g(r), r⃗}, for the solves' passes
   AlignedVector<Real> boundary_pressure_;    // thesis's solver: p_b of the last evaluation (scratch)
   std::vector<std::uint64_t> halo_keys_;     // on ranks: the keys of the own particles and their ghosts (scratch)
   const dist::RankOrder<Real>* ranks_ = nullptr;  // the last evaluation's rank order (null: one rank)
@@ -1053,7 +1053,7 @@ class SphFluid final : public Solver<Real> {
   std::size_t normal_field_ = 0;  // Akinci's normals n_i in local_ (surface tension or adhesion on)
   static constexpr std::string_view kLocalNormalField = "dfsph_surface_normal";
   std::array<AlignedVector<Real>, 3> normals_;  // one rank: the normals n_i; XSPH's Δv (scratch)
-  double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation)
+  double alpha_cap_ = 0;                     // DFSPH: α's cap (set at the first evaluation with fluid)
   static constexpr double kAlphaCapFactor = 2;
   KernelPath kernel_path() const { return params_.simd ? KernelPath::Simd : KernelPath::Scalar; }
 
