@@ -49,8 +49,8 @@ Footprint footprint(const scene::Scene& scene, int ranks) {
     }
     support_in_spacings = std::cbrt(neighbours / 4.18879);  // neighbours = 4π/3 (h/s)³
     solver += 40 + 2 * neighbours * (4 + real);
-    // DFSPH keeps each evaluation's pairs with m_j ∇W_ij for its solves (sph/dfsph_pairs.hpp).
-    if (sph.method == sph::SphMethod::Dfsph) solver += neighbours * (4 + 4 * real);
+    // DFSPH keeps each evaluation's pairs, {j, g(r_ij)}, for its solves (sph/dfsph_pairs.hpp).
+    if (sph.method == sph::SphMethod::Dfsph) solver += neighbours * (4 + real);
     if (sph.neighbour_search == sph::NeighbourSearch::Hash) {
       // The counting sort's offsets and one count per bucket for each chunk (thread).
       const double buckets = sph.buckets ? double(sph.buckets) : 1.6 * n + 1;

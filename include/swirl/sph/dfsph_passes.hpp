@@ -63,6 +63,7 @@
 #include "swirl/spatial/cell_grid.hpp"
 #include "swirl/spatial/distance.hpp"
 #include "swirl/sph/dfsph_pairs.hpp"
+#include "swirl/sph/dfsph_terms.hpp"
 #include "swirl/sph/grid_passes.hpp"
 #include "swirl/sph/kernels.hpp"
 #include "swirl/sph/laws.hpp"
@@ -134,7 +135,7 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
       [&](std::size_t b, std::size_t e) {
         const DfsphKernel<Real> k = kernel;
         std::uint64_t pairs = 0;
-        std::vector<typename DfsphPairs<Real>::Pair>* list = keep ? &keep->start_block(b) : nullptr;
+        typename DfsphPairs<Real>::Block* list = keep ? &keep->start_block(b) : nullptr;
         detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
           if (kind && is_boundary(kind[i])) {
             rho[i] = rest_density;
@@ -152,7 +153,7 @@ std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid
             const Real g = m[j] * gradient;  // m_j ∇W_ij = g · r⃗_ij (0 for j = i)
             gx += g * dx, gy += g * dy, gz += g * dz;
             if (!kind || !is_boundary(kind[j])) g2 += g * g * r2;
-            if (list && j != i) list->push_back({static_cast<std::uint32_t>(j), gradient, dx, dy, dz});
+            if (list && j != i) list->push_back(static_cast<std::uint32_t>(j), gradient);
           });
           if (list) keep->end_list(i - from, list->size());
           rho[i] = density;
@@ -189,7 +190,7 @@ void dfsph_density_change(const spatial::SortedCellGrid<Real>& grid, const Parti
       Real sum = 0;
       detail::for_each_pair(x, y, z, i, ranges, count, k.h2, [&](std::size_t j, Real dx, Real dy, Real dz, Real r2) {
         const Real g = m[j] * k.gradient(std::sqrt(r2));
-        sum += g * ((vx[i] - vx[j]) * dx + (vy[i] - vy[j]) * dy + (vz[i] - vz[j]) * dz);
+        sum = detail::density_change_term(sum, g, vx[i] - vx[j], vy[i] - vy[j], vz[i] - vz[j], dx, dy, dz);
       });
       out[i] = sum;
     });
@@ -216,11 +217,11 @@ void dfsph_pressure_velocity(const spatial::SortedCellGrid<Real>& grid, Particle
       const Real ki = k_over_rho[i];
       detail::for_each_pair(x, y, z, i, ranges, count, k.h2, [&](std::size_t j, Real dx, Real dy, Real dz, Real r2) {
         const Real g = m[j] * (ki + k_over_rho[j]) * k.gradient(std::sqrt(r2));
-        ax += g * dx, ay += g * dy, az += g * dz;
+        ax = detail::fused(g, dx, ax), ay = detail::fused(g, dy, ay), az = detail::fused(g, dz, az);
       });
-      vx[i] -= dt * ax;
-      vy[i] -= dt * ay;
-      vz[i] -= dt * az;
+      vx[i] = detail::fused(-dt, ax, vx[i]);
+      vy[i] = detail::fused(-dt, ay, vy[i]);
+      vz[i] = detail::fused(-dt, az, vz[i]);
     });
   });
 }

@@ -285,25 +285,25 @@ class SphFluid final : public Solver<Real> {
   const Real* factor() const { return alpha_.data() + (ranks_ ? own_.begin : 0); }
   void density_change(const ParticleSet<Real>& p, Real* out, std::size_t block_size) {
     if (!ranks_) {
-      dfsph_density_change(pairs_, p, block_size, out, kinds(p), detail::all_of(p));
+      dfsph_density_change(pairs_, p, block_size, out, kinds(p), detail::all_of(p), kernel_path());
       return;
     }
     to_local(p.velocity, local_.velocity);
     halo_.refresh(ranks_->comm(), local_, {"velocity"});
     local_out_.resize(local_.size());
-    dfsph_density_change(pairs_, local_, block_size, local_out_.data(), kinds(local_), own_);
+    dfsph_density_change(pairs_, local_, block_size, local_out_.data(), kinds(local_), own_, kernel_path());
     std::copy_n(local_out_.data() + own_.begin, p.size(), out);
   }
   void pressure_velocity(ParticleSet<Real>& p, const Real* k_over_rho, Real dt, std::size_t block_size) {
     if (!ranks_) {
-      dfsph_pressure_velocity(pairs_, p, block_size, k_over_rho, dt, kinds(p), detail::all_of(p));
+      dfsph_pressure_velocity(pairs_, p, block_size, k_over_rho, dt, kinds(p), detail::all_of(p), kernel_path());
       return;
     }
     AlignedVector<Real>& kr = local_.extra(kr_field_);
     std::copy_n(k_over_rho, p.size(), kr.data() + own_.begin);
     halo_.refresh(ranks_->comm(), local_, {std::string(kLocalKappaField)});
     to_local(p.velocity, local_.velocity);
-    dfsph_pressure_velocity(pairs_, local_, block_size, kr.data(), dt, kinds(local_), own_);
+    dfsph_pressure_velocity(pairs_, local_, block_size, kr.data(), dt, kinds(local_), own_, kernel_path());
     from_local(local_.velocity, p.velocity);
   }
   // The non-pressure force of the fluid: the thesis's viscosity (eq. 2.10).
