@@ -467,7 +467,8 @@ std::vector<SceneKey> declare_scene_keys() {
                             "(the thesis's spatial hash); docs/sph.md"},
             in_sph(&sph::SphParameters::neighbour_search)));
   add(field(SceneKey{.key = "sph.grid.simd", .section = "sph",
-                     .doc = "grid: explicit SIMD passes; `false` runs their scalar twin (for comparison)"},
+                     .doc = "grid: explicit SIMD passes (and, in float, DFSPH's solve passes over its kept pairs); "
+                            "`false` runs their scalar twins (for comparison)"},
             in_sph(&sph::SphParameters::simd)));
   add(field(SceneKey{.key = "sph.grid.cell_order", .section = "sph", .noun = "cell order",
                      .doc = "grid: `\"rows\"` (row-major cells, 9 ranges per cell) or `\"morton\"` (Z-order, up to 27); "

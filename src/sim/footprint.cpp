@@ -49,8 +49,9 @@ Footprint footprint(const scene::Scene& scene, int ranks) {
     }
     support_in_spacings = std::cbrt(neighbours / 4.18879);  // neighbours = 4π/3 (h/s)³
     solver += 40 + 2 * neighbours * (4 + real);
-    // DFSPH keeps each evaluation's pairs, {j, g(r_ij)}, for its solves (sph/dfsph_pairs.hpp).
-    if (sph.method == sph::SphMethod::Dfsph) solver += neighbours * (4 + real);
+    // DFSPH keeps each evaluation's pairs, {j, g(r_ij)}, for its solves (sph/dfsph_pairs.hpp),
+    // and in float its SIMD passes pack each particle's {z, x, y, m} and {v_z, v_x, v_y, 0}.
+    if (sph.method == sph::SphMethod::Dfsph) solver += neighbours * (4 + real) + (real == 4 ? 32 : 0);
     if (sph.neighbour_search == sph::NeighbourSearch::Hash) {
       // The counting sort's offsets and one count per bucket for each chunk (thread).
       const double buckets = sph.buckets ? double(sph.buckets) : 1.6 * n + 1;

@@ -1,5 +1,5 @@
-// DfsphPairs<Real>: the neighbour pairs of one DFSPH evaluation, with
-// m_j ∇W_ij, kept for the solves that follow it, and the two solve passes
+// DfsphPairs<Real>: the neighbour pairs of one DFSPH evaluation, with their
+// kernel gradient's radial factor, kept for the solves that follow it, and the two solve passes
 // over them (dfsph_density_change and dfsph_pressure_velocity of
 // sph/dfsph_passes.hpp, which stay as their slow twins).
 //
@@ -15,23 +15,42 @@
 //
 // Layout: for each particle i of the pass's range that is not a boundary
 // particle, its neighbours j ≠ i with r_ij < h, in the grid's candidate
-// order, as {j, ∇W's radial factor g(r_ij), r⃗_ij} (20 B a pair in float, 40 in
-// double): the very values the grid passes compute, so the passes here
-// evaluate the same expressions on the same operands. The lists
-// of the particles of one block of the pass (block_size consecutive
-// particles, the blocks of parallel::for_blocks_pinned) are one vector,
-// filled and read by the block's own thread. A boundary particle has an
-// empty list.
+// order, as j and ∇W's radial factor g(r_ij) (8 B a pair in float, 12 in
+// double), in two arrays per block: the lists of the particles of one block
+// of the pass (block_size consecutive particles, the blocks of
+// parallel::for_blocks_pinned), filled and read by the block's own thread. A
+// boundary particle has an empty list. r⃗_ij is not kept: the passes compute
+// x_i − x_j again from the positions, which is the density pass's own
+// subtraction, so they evaluate the grid passes' expressions on the same
+// operands. (Keeping r⃗_ij, 20 B a pair, was the first layout; reading 2.5×
+// fewer bytes made no difference on its own, because the scalar loop was
+// bound by its nine loads a pair, not by memory bandwidth:
+// docs/performance/dfsph.md.)
+//
+// The passes (KernelPath, from sph.grid.simd): Scalar is one pair at a time
+// per particle, two particles' lists side by side (each sum is one chain of
+// multiply-adds in its list's order; two chains keep the FMA unit busy);
+// Simd, in float, runs sph/dfsph_pair_kernels.hpp's per-instruction-set
+// bodies on particles packed as {z, x, y, m} and {v_z, v_x, v_y, 0} (16 B
+// each, kept here: the positions packed once per filling, the velocities at
+// every density-change pass), reading a neighbour with one or two vector loads
+// instead of seven scalar ones; in double Simd runs the scalar loops. Every
+// multiply-add is spelled out (sph/dfsph_terms.hpp), so that both paths and
+// the grid twins round alike: the same bits where the build's scalar code
+// and the SIMD copy both fuse (or both do not: the SSE2 copy never does).
 //
 // Invariants: valid for the positions, masses and kinds of the evaluation
 // that filled it, for the same range and block_size (the solve passes check
-// both and throw std::logic_error otherwise). The sums go over each list in
-// order, so the results are the same for any thread count, and for any rank
-// count (the candidate order is the global key order), and they are the grid
-// passes' bits (tests/sph/dfsph_pairs_test.cpp): keeping m_j ∇W_ij as one
-// rounded vector (16 B) was tried first and changed results by rounding, which
-// a DFSPH solve's stopping test turns into other iteration counts (the
-// hydrostatic tank's pressure line moved from within 1 % to 1.9 %).
+// both and throw std::logic_error otherwise; the positions are read again, so
+// they must not change between the filling and the solves — the stepper moves
+// particles only after its density solve and then evaluates again). The sums
+// go over each list in order, so the results are the same for any thread
+// count, and for any rank count (the candidate order is the global key
+// order), and they are the grid passes' bits (tests/sph/dfsph_pairs_test.cpp):
+// keeping m_j ∇W_ij as one rounded vector (16 B) was tried first and changed
+// results by rounding, which a DFSPH solve's stopping test turns into other
+// iteration counts (the hydrostatic tank's pressure line moved from within 1 %
+// to 1.9 %).
 // Units: as dfsph_passes.hpp (g in 1/m⁵, r⃗ in m).
 #pragma once
 

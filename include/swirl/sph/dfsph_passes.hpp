@@ -44,7 +44,8 @@
 //
 // Scalar loops, one pair at a time. The solves run dfsph_density_change and
 // dfsph_pressure_velocity over the pairs the density pass kept
-// (sph/dfsph_pairs.hpp); the grid versions here are their slow twins.
+// (sph/dfsph_pairs.hpp); the grid versions here are their slow twins, and
+// both write their multiply-adds as sph/dfsph_terms.hpp's (the same bits).
 // Each pass writes only particle i's entries and gathers over the grid's fixed
 // candidate ranges, so its result is bit-identical for any thread count.
 // Units: SI (ρ in kg/m³, κ in m²/s², α in m⁶·s⁰/kg: ρ/(kg²/m⁸)).
@@ -118,7 +119,7 @@ double dfsph_lattice_factor(const DfsphKernel<Real>& kernel, double m, double s)
 // ρ into p.density, α into alpha[0, n), α at most alpha_cap; returns the
 // neighbour pairs (self excluded). kind: null, or the particles' kinds (then
 // a boundary particle gets ρ = rest_density and α = 0). keep: null, or where
-// the pairs found and their m_j ∇W_ij are kept for the solves
+// the pairs found and their ∇W radial factors are kept for the solves
 // (sph/dfsph_pairs.hpp).
 template <class Real>
 std::uint64_t dfsph_density_and_factor(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
