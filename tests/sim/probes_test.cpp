@@ -274,7 +274,7 @@ TEST(ProbesHydrostatic, TheThesisSolversReactionBalancesTheFluidsMomentum) {
   text = swap(text, "viscosity = 0.5", "viscosity = 0.0");
   Simulation<double> sim = sim::build_simulation<double>(scene::parse_scene(text, "scene.toml"));
   sim.start();
-  const auto& fluid = *sim.find_solver<sph::SphFluid<double>>();
+  sph::SphFluid<double>& fluid = fluid_of(sim);
   const double weight = kRho0 * L * L * depth * kG;
   std::vector<double> f;
   double worst = 0, largest = 0;

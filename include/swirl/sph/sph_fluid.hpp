@@ -120,7 +120,10 @@
 //  - DFSPH: the evaluation builds a local set (own particles among ghosts)
 //    that the stepper's passes use until the next evaluation; each pass first
 //    refreshes what it reads of the ghosts (velocities, κ/ρ), and the solves'
-//    errors are the one-rank block-order sums (block_sum, dist/block_sum.hpp).
+//    errors are the one-rank block-order sums (block_sum, dist/block_sum.hpp);
+//  - the walls' reaction (boundary_forces(), DFSPH's recorded density-solve
+//    reaction): each rank's own boundary particles among their ghosts, sent
+//    again through the last evaluation's halo (with_ghosts()).
 // The hash search is refused there (distributed_support()).
 //
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
