@@ -970,7 +970,7 @@ std::vector<SourceKey> obstacle_keys(ObstacleSource::Shape shape) {
           .doc = "a prescribed rigid motion of the obstacle as placed above (its rest position; docs/sph.md, Moving "
                  "obstacles): `\"piston\"` (a translation), `\"flap\"` (an oscillating rotation about a hinge) or "
                  "`\"rotation\"` (a steady one); its particles are put at the motion's x and v before every force "
-                 "evaluation (grid search, one MPI rank)",
+                 "evaluation (grid search; on several MPI ranks too)",
           .default_doc = "– (static)"},
          &boundary::RigidMotion::kind, kAnyMotion);
   motion({.key = "motion.direction",

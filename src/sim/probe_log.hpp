@@ -15,6 +15,20 @@
 // sums run serially in memory order in double: the same bits for any thread
 // count and after a resume (which restores the order).
 //
+// On several ranks (Simulation::ranks()) every rank calls the observer at the
+// same steps, and a row is the one-rank row byte for byte. The one-rank sums
+// are serial over the memory order, which is the ranks' particles in rank
+// order, and a float sum cut at the ranks and added again is not the same
+// bits; so the terms are gathered, not partial sums: each rank sends rank 0
+// its own particles that can reach a probe (a point's fluid particles within
+// h, a line's within h of it: the only ones whose weight is not 0) and the
+// per-particle force and torque terms of its own obstacle particles, all in
+// its memory order; rank 0 concatenates them in rank order (the global
+// order) and sums them as one rank does, over the same particles in the
+// same order (a particle whose weight is 0 adds nothing there either). A
+// row costs one gather of a few dozen particles per probe and 56 B per
+// obstacle particle; ghosts are never sent (each particle once, by its owner).
+//
 // Resume: the rows written before the checkpoint are kept (read back from the
 // file, as many as the checkpoint says), the later ones replaced; a resumed
 // run's file is byte for byte the uninterrupted run's.
@@ -22,6 +36,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <sstream>
@@ -31,6 +46,7 @@
 
 #include <fmt/format.h>
 
+#include "swirl/dist/communicator.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/run_folder.hpp"
 #include "swirl/scene/initial_conditions.hpp"
@@ -88,7 +104,7 @@ class ProbeLog final : public Observer<Real> {
     rows_ = static_cast<std::size_t>(find_value(values, "probes.rows").value_or(0));
     schedule_.set_next_index(static_cast<std::uint64_t>(find_value(values, "probes.next").value_or(1)));
     last_step_ = static_cast<std::uint64_t>(find_value(values, "probes.last_step").value_or(0));
-    if (!std::filesystem::exists(path_)) return;
+    if (!folder_ || !std::filesystem::exists(path_)) return;  // on ranks: rank 0 writes
     std::istringstream in(io::read_text_file(path_));
     std::string line;
     std::getline(in, line);  // the header, as this version writes it (the scene hash fixes the probes)
@@ -98,28 +114,75 @@ class ProbeLog final : public Observer<Real> {
  private:
   void add_row(Simulation<Real>& sim) {
     ScopedPhase phase(sim.timers(), "output");
-    const ParticleSet<Real>& p = sim.particles();  // one rank only (probes are refused on several)
+    const dist::Communicator* comm = sim.ranks() ? &sim.ranks()->comm() : nullptr;
+    const ParticleSet<Real>& p = sim.particles();  // on ranks: this rank's own particles
     std::vector<double> row{sim.time()};
-    for (const auto& probe : probes_)
-      row.push_back(probe.point ? sampler_->pressure(p, *probe.point) : sampler_->height(p, probe.line[0], probe.line[1]));
-    if (!obstacles_.empty()) add_obstacles(sim, row);
-    for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
-    text_ += "\n";
+    if (!probes_.empty()) {
+      const ParticleSet<Real>& at = comm ? near_probes(*comm, p) : p;
+      for (const auto& probe : probes_)
+        row.push_back(probe.point ? sampler_->pressure(at, *probe.point) : sampler_->height(at, probe.line[0], probe.line[1]));
+    }
+    if (!obstacles_.empty()) add_obstacles(sim, comm, row);
     ++rows_;
     last_step_ = sim.step_count();
+    if (comm && !comm->is_root()) return;  // its row holds its share only; rank 0 writes
+    for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
+    text_ += "\n";
     if (folder_) io::write_file_atomic(folder_->claim(path_), text_);
+  }
+
+  // On ranks, collective: the fluid particles of every rank that can reach a
+  // probe (ProbeSampler::reaches_point, reaches_line), their position, mass,
+  // density and pressure, on rank 0 in global order (empty on the others).
+  const ParticleSet<Real>& near_probes(const dist::Communicator& comm, const ParticleSet<Real>& p) {
+    const std::size_t k = p.find_int_field(kKindField);
+    const std::int32_t* kind = k == ParticleSet<Real>::npos ? nullptr : p.int_field(k).data();
+    constexpr std::size_t kReals = 6;
+    std::vector<Real> mine;
+    for (std::size_t j = 0; j < p.size(); ++j) {
+      if (kind && is_boundary(kind[j])) continue;
+      bool reaches = false;
+      for (const auto& probe : probes_)
+        if (probe.point ? sampler_->reaches_point(p, j, *probe.point) : sampler_->reaches_line(p, j, probe.line[0], probe.line[1])) {
+          reaches = true;
+          break;
+        }
+      if (reaches)
+        mine.insert(mine.end(), {p.position.x[j], p.position.y[j], p.position.z[j], p.mass[j], p.density[j], p.pressure[j]});
+    }
+    dist::Bytes bytes(mine.size() * sizeof(Real));
+    if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
+    const std::vector<dist::Bytes> all = comm.gather_to_root(bytes);
+    std::size_t n = 0;
+    for (const dist::Bytes& b : all) n += b.size() / (kReals * sizeof(Real));
+    near_ = ParticleSet<Real>(n);
+    std::size_t i = 0;
+    for (const dist::Bytes& b : all)
+      for (std::size_t at = 0; at + kReals * sizeof(Real) <= b.size(); at += kReals * sizeof(Real), ++i) {
+        Real v[kReals];
+        std::memcpy(v, b.data() + at, sizeof v);
+        near_.position.set(i, Vec3<Real>{v[0], v[1], v[2]});
+        near_.mass[i] = v[3], near_.density[i] = v[4], near_.pressure[i] = v[5];
+      }
+    return near_;
   }
 
   // Each obstacle's force F = Σ F_b and torque Σ (x_b − c) × F_b over its
   // boundary particles, in memory order (c: the centre at the row's time).
-  void add_obstacles(const Simulation<Real>& sim, std::vector<double>& row) {
-    const auto* fluid = sim.template find_solver<sph::SphFluid<Real>>();
+  // Every particle's terms first (on ranks: each rank its own, gathered to
+  // rank 0 in rank order), then the sums, so one rank and several run the
+  // same additions in the same order.
+  void add_obstacles(Simulation<Real>& sim, const dist::Communicator* comm, std::vector<double>& row) {
+    sph::SphFluid<Real>* fluid = nullptr;
+    for (const auto& s : sim.solvers())
+      if (auto* f = dynamic_cast<sph::SphFluid<Real>*>(s.get())) fluid = f;
     if (!fluid) throw std::logic_error("ProbeLog: obstacle forces without the SPH solver");
     const ParticleSet<Real>& p = sim.particles();
-    fluid->boundary_forces(p, block_size_, forces_);
-    std::vector<std::array<double, 6>> sums(obstacles_.size(), std::array<double, 6>{});
+    fluid->boundary_forces(p, block_size_, forces_);  // collective on ranks
     std::vector<Vec3d> centres;  // a moving obstacle's torque is about its centre where it is now
     for (const auto& o : obstacles_) centres.push_back(o.centre_at(sim.time()));
+    constexpr std::size_t kTerm = 7;  // obstacle, F, (x − c) × F
+    std::vector<double> terms;
     for (std::size_t i = 0; i < p.size(); ++i) {
       const std::uint64_t id = p.id[i];
       // The obstacles' id ranges are disjoint and in increasing order.
@@ -133,9 +196,22 @@ class ProbeLog final : public Observer<Real> {
       const Vec3d& c = centres[k];
       const double rx = double(p.position.x[i]) - c.x, ry = double(p.position.y[i]) - c.y,
                    rz = double(p.position.z[i]) - c.z;
-      auto& s = sums[k];
-      s[0] += fx, s[1] += fy, s[2] += fz;
-      s[3] += ry * fz - rz * fy, s[4] += rz * fx - rx * fz, s[5] += rx * fy - ry * fx;
+      terms.insert(terms.end(), {double(k), fx, fy, fz, ry * fz - rz * fy, rz * fx - rx * fz, rx * fy - ry * fx});
+    }
+    if (comm) {
+      dist::Bytes bytes(terms.size() * sizeof(double));
+      if (!terms.empty()) std::memcpy(bytes.data(), terms.data(), bytes.size());
+      terms.clear();
+      for (const dist::Bytes& b : comm->gather_to_root(bytes)) {
+        const std::size_t at = terms.size();
+        terms.resize(at + b.size() / sizeof(double));
+        if (!b.empty()) std::memcpy(terms.data() + at, b.data(), b.size());
+      }
+    }
+    std::vector<std::array<double, 6>> sums(obstacles_.size(), std::array<double, 6>{});
+    for (std::size_t t = 0; t + kTerm <= terms.size(); t += kTerm) {
+      auto& s = sums[static_cast<std::size_t>(terms[t])];
+      for (std::size_t c = 0; c < 6; ++c) s[c] += terms[t + 1 + c];
     }
     for (const auto& s : sums) row.insert(row.end(), s.begin(), s.end());
   }
@@ -148,6 +224,7 @@ class ProbeLog final : public Observer<Real> {
   std::optional<sph::ProbeSampler> sampler_;
   io::RunFolder* folder_;  // null: nothing written (a run without a folder)
   std::vector<double> forces_;  // per particle, 3 each (scratch)
+  ParticleSet<Real> near_;      // on ranks, rank 0: the particles near the probes (scratch)
   std::string text_;
   std::size_t rows_ = 0;
   std::uint64_t last_step_ = 0;

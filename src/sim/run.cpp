@@ -888,12 +888,8 @@ std::string distributed_support_of(const scene::Scene& scene) {
     if (!no.empty()) return no;
   }
   if (scene.has_inlets_or_outlets()) return "inlets and outlets ([[inlets]], [[outlets]]: a particle count that changes)";
-  // Boundary particles (box.walls = "particles", obstacles) run on ranks too.
-  // probes.csv samples the whole set on one rank; on ranks it would need the
-  // gathered state every probe row (docs/sph.md, Probes).
-  if (scene.has_probe_output()) return "probes ([[probes]], output.obstacle_forces)";
-  // Their rest positions are built on rank 0; the ranks would each need them.
-  if (scene.has_moving_obstacles()) return "moving obstacles (an obstacle's `motion`)";
+  // Boundary particles (box.walls = "particles", obstacles, moving ones),
+  // probes and obstacle forces run on ranks too.
   return {};
 }
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `swirl run` on several MPI ranks (issue 19, points 1, 5, 6 and 7): the same
-# scene (SPH, self-gravity, both; DFSPH and boundary particles) on 1 (no
-# mpirun), 2, 3 and 4 ranks gives byte-identical frames, diagnostics and
-# checkpoints; a run resumes on another rank count and ends with the one-rank
+# scene (SPH, self-gravity, both; DFSPH and boundary particles; probes,
+# obstacle forces and moving obstacles) on 1 (no mpirun), 2, 3 and 4 ranks
+# gives byte-identical frames, diagnostics, probes.csv and checkpoints; a run resumes on another rank count and ends with the one-rank
 # bytes; a blow-up stops every rank with the one-rank
 # message and keeps the frames; a scene part that is not distributed yet is
 # refused once with status 2 and leaves no folder; more ranks than particles
@@ -27,10 +27,11 @@ on_ranks() {  # on_ranks N ARGS...: swirl on N ranks (1: without mpirun); status
   fi
   status=$?
 }
-# same_files REF DIR WHAT: every frame, the diagnostics and every checkpoint of REF, byte for byte in DIR.
+# same_files REF DIR WHAT: every frame, the diagnostics, probes.csv (when REF
+# has one) and every checkpoint of REF, byte for byte in DIR.
 same_files() {
   local ref=$1 dir=$2 what=$3 f n=0
-  for f in "$ref"/particles_*.vtp "$ref"/particles.pvd "$ref"/diagnostics.csv "$ref"/checkpoints/*.swc; do
+  for f in "$ref"/particles_*.vtp "$ref"/particles.pvd "$ref"/diagnostics.csv "$ref"/probes.csv "$ref"/checkpoints/*.swc; do
     [ -e "$f" ] || continue
     n=$((n + 1))
     cmp -s "$f" "$dir/${f#"$ref"/}" || fail "$what: ${f#"$ref"/} differs from the one-rank file"
@@ -99,11 +100,12 @@ same_files "$out/drop_1" "$out/drop_3" "SPH with self-gravity on 3 ranks"
 #     particles: box.walls = "particles" and an obstacle_box), DFSPH in double
 #     with tolerances tight enough for 9-14 iterations per solve, adaptive
 #     steps, on 2 and 3 ranks against one; then resumed 3 -> 2 ranks; and the
-#     thesis's solver with walls of particles (the dam break) on 3 ranks.
-# (its probes, refused on ranks, are turned off)
+#     thesis's solver with walls of particles (the dam break) on 3 ranks. Both
+#     with probes.csv: the example's four water-height lines and the force and
+#     torque on the obstacle and the walls (DFSPH's recorded density-solve
+#     reaction included); the thesis's run with a pressure point and a line.
 obstacle=("$examples/dam_break_obstacle.toml" --set particles.0.spacing=0.1 --set output.interval=0.05
-          --set 'probes=[]' --set output.obstacle_forces=false
-          --set 'simulation.precision="double"' --set simulation.dt_max=0.01
+          --set output.probes_interval=0.02 --set 'simulation.precision="double"' --set simulation.dt_max=0.01
           --set sph.dfsph.density_tolerance=2e-5 --set sph.dfsph.divergence_tolerance=2e-5)
 on_ranks 1 run "${obstacle[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/dfsph_1"
 [ "$status" -eq 0 ] || { fail "dfsph on 1 rank: status $status"; cat "$out/stderr"; }
@@ -117,7 +119,7 @@ on_ranks 3 run "${obstacle[@]}" --steps 17 --checkpoint-every-steps 5 --out "$di
 [ "$status" -eq 0 ] || { fail "dfsph resume 3 -> 2: the first part: status $status"; cat "$out/stderr"; }
 on_ranks 2 run --resume "$dir" --steps 15 --checkpoint-every-steps 10
 [ "$status" -eq 0 ] || { fail "dfsph resume 3 -> 2: status $status"; cat "$out/stderr"; }
-for f in particles_000003.vtp diagnostics.csv checkpoints/checkpoint_000000000030.swc; do
+for f in particles_000003.vtp diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc; do
   cmp -s "$out/dfsph_1/$f" "$dir/$f" || fail "dfsph resume 3 -> 2 ranks: $f differs from the uninterrupted one-rank run"
 done
 # 4c. The same with DFSPH's XSPH filter, surface tension and adhesion on
@@ -131,12 +133,40 @@ on_ranks 3 run "${terms[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/
 same_files "$out/terms_1" "$out/terms_3" "dfsph with xsph, surface tension and adhesion on 3 ranks"
 cmp -s "$out/dfsph_1/particles_000003.vtp" "$out/terms_1/particles_000003.vtp" &&
   fail "dfsph: sph.xsph, sph.surface_tension and sph.adhesion changed nothing"
-walls=("$scene" "${small[@]}" --set 'box.walls="particles"' --steps 30 --checkpoint-every-steps 10)
+walls=("$scene" "${small[@]}" --set 'box.walls="particles"' --steps 30 --checkpoint-every-steps 10
+       --set output.obstacle_forces=true
+       --set 'probes=[{name="p", point=[0.1, 0.1, 0.05]}, {name="h", line=[[0.05, 0.1, 0.0], [0.05, 0.1, 0.4]]}]')
 on_ranks 1 run "${walls[@]}" --out "$out/walls_1"
 [ "$status" -eq 0 ] || { fail "walls of particles on 1 rank: status $status"; cat "$out/stderr"; }
 on_ranks 3 run "${walls[@]}" --out "$out/walls_3"
 [ "$status" -eq 0 ] || { fail "walls of particles on 3 ranks: status $status"; cat "$out/stderr"; }
 same_files "$out/walls_1" "$out/walls_3" "the thesis's solver with walls of particles on 3 ranks"
+awk -F, 'NR > 1 && $2 != 0 && $3 != 0 && $4 != 0 { ok = 1 } END { exit !ok }' "$out/walls_1/probes.csv" ||
+  fail "walls of particles: probes.csv holds no pressure, height or wall force to compare"
+
+# 4d. Moving obstacles (docs/sph.md): the sloshing tank (DFSPH, float, about
+#     1 300 water and 2 400 boundary particles, the tank rolling as a flap at
+#     2 Hz, 8 degrees, from t = 0), with its probes.csv (two water-height
+#     lines, the tank's force and torque about its moving centre), on 2 and 3
+#     ranks against one, and resumed 3 -> 2. The tank's particles cross the
+#     cuts as it rolls: the density solve's recorded reactions follow them.
+slosh=("$examples/sloshing.toml" --set particles.1.motion.ramp=0 --set particles.1.motion.amplitude_deg=8
+       --set particles.1.motion.frequency=2 --set output.interval=0.05)
+on_ranks 1 run "${slosh[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/moving_1"
+[ "$status" -eq 0 ] || { fail "moving obstacle on 1 rank: status $status"; cat "$out/stderr"; }
+for n in 2 3; do
+  on_ranks "$n" run "${slosh[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/moving_$n"
+  [ "$status" -eq 0 ] || { fail "moving obstacle on $n ranks: status $status"; cat "$out/stderr"; }
+  same_files "$out/moving_1" "$out/moving_$n" "a moving obstacle with probes on $n ranks"
+done
+dir="$out/moving_resume_3_2"
+on_ranks 3 run "${slosh[@]}" --steps 17 --checkpoint-every-steps 5 --out "$dir"
+[ "$status" -eq 0 ] || { fail "moving obstacle resume 3 -> 2: the first part: status $status"; cat "$out/stderr"; }
+on_ranks 2 run --resume "$dir" --steps 15 --checkpoint-every-steps 10
+[ "$status" -eq 0 ] || { fail "moving obstacle resume 3 -> 2: status $status"; cat "$out/stderr"; }
+for f in particles_000001.vtp diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc; do
+  cmp -s "$out/moving_1/$f" "$dir/$f" || fail "moving obstacle resume 3 -> 2 ranks: $f differs from the uninterrupted one-rank run"
+done
 
 # 5. A blow-up (a step far beyond the CFL limit) on 3 ranks: status 1, the
 #    one-rank message exactly, printed once; frame 0 kept.
@@ -162,11 +192,11 @@ cat "$out/stderr"
 on_ranks 2 run "$examples/plummer.toml" --set 'nbody.method="fmm"' --steps 2 --out "$out/refused"
 [ "$status" -eq 2 ] || fail "the FMM on 2 ranks: status $status (want 2)"
 grep -q 'nbody.method = "fmm" does not run on several MPI ranks yet' "$out/stderr" || fail "the FMM on 2 ranks: not said why"
-on_ranks 2 run "$scene" "${small[@]}" --set 'probes=[{name="p", point=[0.1, 0.1, 0.05]}]' --steps 2 --out "$out/refused"
-[ "$status" -eq 2 ] || fail "probes on 2 ranks: status $status (want 2)"
-grep -q 'probes (\[\[probes\]\], output.obstacle_forces) does not run on several MPI ranks yet' "$out/stderr" ||
-  fail "probes on 2 ranks: not said why"
-[ ! -e "$out/refused" ] || fail "probes on 2 ranks: the refused run created its folder"
+on_ranks 2 run "$examples/tap.toml" --steps 2 --out "$out/refused"
+[ "$status" -eq 2 ] || fail "inlets on 2 ranks: status $status (want 2)"
+grep -q 'inlets and outlets (\[\[inlets\]\], \[\[outlets\]\]: a particle count that changes) does not run on several MPI ranks yet' \
+  "$out/stderr" || fail "inlets on 2 ranks: not said why"
+[ ! -e "$out/refused" ] || fail "inlets on 2 ranks: the refused run created its folder"
 
 # 7. The folder's lock and files are rank 0's: a second run into a folder
 #    holding another run is refused on every rank with status 2.

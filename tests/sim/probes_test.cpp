@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -24,6 +25,7 @@
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/run.hpp"
+#include "swirl/sph/probes.hpp"
 #include "swirl/sph/sph_fluid.hpp"
 
 namespace {
@@ -274,7 +276,7 @@ TEST(ProbesHydrostatic, TheThesisSolversReactionBalancesTheFluidsMomentum) {
   text = swap(text, "viscosity = 0.5", "viscosity = 0.0");
   Simulation<double> sim = sim::build_simulation<double>(scene::parse_scene(text, "scene.toml"));
   sim.start();
-  const auto& fluid = *sim.find_solver<sph::SphFluid<double>>();
+  sph::SphFluid<double>& fluid = fluid_of(sim);
   const double weight = kRho0 * L * L * depth * kG;
   std::vector<double> f;
   double worst = 0, largest = 0;
@@ -478,6 +480,70 @@ TEST(ProbesScene, ScenesWithoutProbesKeepTheirHash) {
   EXPECT_NE(scene::scene_hash(scene::parse_scene(
                 without + "[[probes]]\nname = \"a\"\npoint = [0.06, 0.06, 0.1]\n", "tank.toml")),
             base);
+}
+
+// On several ranks rank 0 evaluates the probes over the particles the ranks
+// chose with reaches_point / reaches_line (src/sim/probe_log.hpp): those must
+// be every particle that adds to a probe, so that the sums over them, in the
+// same order, are the sums over the whole set bit for bit. A cloud of water
+// particles (random, with random densities and pressures) around a point and
+// a line, the thesis's kernel and DFSPH's cubic spline, float and double.
+template <class Real>
+void reaching_particles_give_the_whole_sets_bits(sph::SphKernel kernel) {
+  sph::SphParameters params;
+  params.smoothing_length = 0.04;
+  params.method = kernel == sph::SphKernel::Thesis ? sph::SphMethod::Wcsph : sph::SphMethod::Dfsph;
+  params.kernel = kernel;
+  const sph::ProbeSampler sampler(params);
+  const Vec3d point{0.1, 0.1, 0.1}, lower{0.12, 0.08, 0.0}, upper{0.12, 0.08, 0.2};
+  const std::size_t n = 4000;
+  ParticleSet<Real> all(n);
+  std::uint64_t state = 12345;
+  auto uniform = [&state] {  // a fixed LCG: the same cloud on every machine
+    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+    return double(state >> 11) / double(1ULL << 53);
+  };
+  for (std::size_t j = 0; j < n; ++j) {
+    all.position.set(j, Vec3<Real>{Real(0.2 * uniform()), Real(0.2 * uniform()), Real(0.15 * uniform())});
+    all.mass[j] = Real(0.02 * (0.9 + 0.2 * uniform()));
+    all.density[j] = Real(1000 * (0.95 + 0.1 * uniform()));
+    all.pressure[j] = Real(500 * uniform());
+  }
+  ParticleSet<Real> near_point(0), near_line(0);
+  std::vector<std::size_t> pj, lj;
+  for (std::size_t j = 0; j < n; ++j) {
+    if (sampler.reaches_point(all, j, point)) pj.push_back(j);
+    if (sampler.reaches_line(all, j, lower, upper)) lj.push_back(j);
+  }
+  auto subset = [&](const std::vector<std::size_t>& js) {
+    ParticleSet<Real> s(js.size());
+    for (std::size_t k = 0; k < js.size(); ++k) {
+      s.position.set(k, all.position.get(js[k]));
+      s.mass[k] = all.mass[js[k]], s.density[k] = all.density[js[k]], s.pressure[k] = all.pressure[js[k]];
+    }
+    return s;
+  };
+  near_point = subset(pj), near_line = subset(lj);
+  // The cloud reaches well beyond h of the probes, and each has neighbours.
+  ASSERT_GT(pj.size(), 20u);
+  ASSERT_LT(pj.size(), n / 10);
+  ASSERT_GT(lj.size(), 100u);
+  ASSERT_LT(lj.size(), n / 3);
+  const double p = sampler.pressure(all, point), h = sampler.height(all, lower, upper);
+  EXPECT_GT(p, 0);
+  EXPECT_GT(h, 0);
+  EXPECT_LT(h, upper.z - lower.z);  // the cloud's top is inside the line
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(sampler.pressure(near_point, point)), std::bit_cast<std::uint64_t>(p));
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(sampler.height(near_line, lower, upper)), std::bit_cast<std::uint64_t>(h));
+  EXPECT_EQ(std::bit_cast<std::uint64_t>(sampler.colour(near_point, point)),
+            std::bit_cast<std::uint64_t>(sampler.colour(all, point)));
+}
+
+TEST(ProbeSampler, TheParticlesThatReachAProbeGiveTheWholeSetsBits) {
+  reaching_particles_give_the_whole_sets_bits<float>(sph::SphKernel::Thesis);
+  reaching_particles_give_the_whole_sets_bits<double>(sph::SphKernel::Thesis);
+  reaching_particles_give_the_whole_sets_bits<float>(sph::SphKernel::CubicSpline);
+  reaching_particles_give_the_whole_sets_bits<double>(sph::SphKernel::CubicSpline);
 }
 
 }  // namespace

@@ -50,7 +50,10 @@
 // before every force evaluation at time t, and so before the order's sort,
 // their boundary particles are put at the prescribed motion's position and
 // velocity for t; their acceleration is zeroed as every boundary particle's.
-// They hold no state of their own (the motion is a function of t).
+// They hold no state of their own (the motion is a function of t). On several
+// ranks each rank holds the whole rest table, keyed by id, and places the
+// particles it holds: a particle's place depends on its id and t alone, so
+// where the cuts fall changes nothing.
 //
 // Checkpoints: save_state()/resume() carry the clock, the controller, the
 // stepper's and every solver's state; the particle fields (including the
@@ -147,17 +150,15 @@ class Simulation {
     if (started_) throw std::logic_error("Simulation::distribute() after start()");
     whole_on_root_ = whole_on_root;
     if (comm.distributed()) {
-      if (moving_ && !moving_->empty()) throw std::invalid_argument("moving obstacles do not run on several MPI ranks yet");
       ranks_ = std::make_unique<dist::RankOrder<Real>>(comm);
       ranks_->set_rebalance_threshold(settings_.rebalance_threshold);
     }
   }
-  // Obstacles whose boundary particles follow a prescribed motion (one rank
-  // only: distribute() refuses them). Before start() or resume().
+  // Obstacles whose boundary particles follow a prescribed motion. Before
+  // start() or resume(). On several ranks every rank holds the same whole
+  // table (by id): each places the moving particles it holds.
   void set_moving_boundaries(std::shared_ptr<const boundary::MovingBoundaries> moving) {
     if (started_) throw std::logic_error("Simulation::set_moving_boundaries() after start()");
-    if (ranks_ && moving && !moving->empty())
-      throw std::invalid_argument("moving obstacles do not run on several MPI ranks yet");
     moving_ = std::move(moving);
   }
   const boundary::MovingBoundaries* moving_boundaries() const { return moving_.get(); }

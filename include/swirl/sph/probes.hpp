@@ -78,12 +78,8 @@ class ProbeSampler {
     // The fluid particles that can reach the line: within h of its axis and its ends.
     const std::int32_t* kind = kinds(p);
     near_.clear();
-    for (std::size_t j = 0; j < p.size(); ++j) {
-      if (kind && is_boundary(kind[j])) continue;
-      const double dx = double(p.position.x[j]) - lower.x, dy = double(p.position.y[j]) - lower.y;
-      const double z = double(p.position.z[j]);
-      if (dx * dx + dy * dy < h * h && z > lower.z - h && z < upper.z + h) near_.push_back(j);
-    }
+    for (std::size_t j = 0; j < p.size(); ++j)
+      if ((!kind || !is_boundary(kind[j])) && reaches_line(p, j, lower, upper)) near_.push_back(j);
     if (near_.empty() || !(length > 0)) return 0.0;
     const auto samples = static_cast<std::size_t>(std::min(std::ceil(length / (h / 8)), 1e6));
     const double step = length / static_cast<double>(samples);
@@ -104,7 +100,31 @@ class ProbeSampler {
     return 0.0;
   }
 
+  // Whether particle j can add to a sum at the point `at`: its weight there
+  // is not 0 only if this holds (within h). On several ranks these choose
+  // the particles sent to the rank that writes probes.csv (sim/probe_log.hpp).
+  template <class Real>
+  bool reaches_point(const ParticleSet<Real>& p, std::size_t j, const Vec3d& at) const {
+    return distance2(p, j, at) < kernel_.h2;
+  }
+  // Whether particle j is among the particles height() samples along the
+  // line from `lower` to `upper`: within h of its axis and of its ends.
+  template <class Real>
+  bool reaches_line(const ParticleSet<Real>& p, std::size_t j, const Vec3d& lower, const Vec3d& upper) const {
+    const double h = kernel_.h;
+    const double dx = double(p.position.x[j]) - lower.x, dy = double(p.position.y[j]) - lower.y;
+    const double z = double(p.position.z[j]);
+    return dx * dx + dy * dy < h * h && z > lower.z - h && z < upper.z + h;
+  }
+
  private:
+  template <class Real>
+  static double distance2(const ParticleSet<Real>& p, std::size_t j, const Vec3d& at) {
+    const double dx = at.x - double(p.position.x[j]), dy = at.y - double(p.position.y[j]),
+                 dz = at.z - double(p.position.z[j]);
+    return dx * dx + dy * dy + dz * dz;
+  }
+
   template <class Real>
   static const std::int32_t* kinds(const ParticleSet<Real>& p) {
     const std::size_t k = p.find_int_field(kKindField);
@@ -114,9 +134,7 @@ class ProbeSampler {
   // V_j W(x − x_j), 0 beyond h.
   template <class Real>
   double weight(const ParticleSet<Real>& p, std::size_t j, const Vec3d& at) const {
-    const double dx = at.x - double(p.position.x[j]), dy = at.y - double(p.position.y[j]),
-                 dz = at.z - double(p.position.z[j]);
-    const double r2 = dx * dx + dy * dy + dz * dz;
+    const double r2 = distance2(p, j, at);
     if (!(r2 < kernel_.h2)) return 0.0;
     const double rho = double(p.density[j]);
     if (!(rho > 0)) return 0.0;

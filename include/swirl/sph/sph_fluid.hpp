@@ -120,7 +120,10 @@
 //  - DFSPH: the evaluation builds a local set (own particles among ghosts)
 //    that the stepper's passes use until the next evaluation; each pass first
 //    refreshes what it reads of the ghosts (velocities, κ/ρ), and the solves'
-//    errors are the one-rank block-order sums (block_sum, dist/block_sum.hpp).
+//    errors are the one-rank block-order sums (block_sum, dist/block_sum.hpp);
+//  - the walls' reaction (boundary_forces(), DFSPH's recorded density-solve
+//    reaction): each rank's own boundary particles among their ghosts, sent
+//    again through the last evaluation's halo (with_ghosts()).
 // The hash search is refused there (distributed_support()).
 //
 // Units: SI. h in m, ρ0 in kg/m³, c in m/s, μ in Pa·s.
@@ -134,6 +137,7 @@
 #include <span>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -398,34 +402,35 @@ class SphFluid final : public Solver<Real> {
   // those of the step's start, κ the solve's final one): the reaction of the
   // walls' part of its impulse, F_b = Σ_j m_j ψ_b (κ_j/ρ_j) ∇W_jb (the
   // solve's velocity change of j is linear in κ, so this is the sum over its
-  // iterations and its warm start), kept by id until the next step.
+  // iterations and its warm start), kept by id until the next step. On
+  // several ranks collective: each rank records its own boundary particles
+  // among their ghosts (exchange 1 of x, m, ρ, κ, kind); a record whose
+  // particle moves to another rank at the next sort follows it there when
+  // boundary_forces() asks (settle_reactions()).
   void record_density_reaction(const ParticleSet<Real>& p, std::size_t block_size) {
-    const std::int32_t* kind = kinds(p);
-    if (!kind || !kernel_) return;
-    const std::size_t k1 = p.find_field(kKappaField);
-    if (k1 == ParticleSet<Real>::npos) throw std::logic_error("SPH: the constant-density solve's κ is not declared");
-    std::uint64_t ids = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) ids = std::max<std::uint64_t>(ids, std::uint64_t(p.id[i]) + 1);
-    density_reaction_.assign(3 * ids, 0.0);
-    const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
-    const Real *rho = p.density.data(), *kappa = p.extra(k1).data();
-    double* out = density_reaction_.data();
-    parallel::for_blocks_pinned("sph_boundary_reaction", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
-      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
-        if (!is_boundary(kind[i])) return;
-        double fx = 0, fy = 0, fz = 0;
-        detail::for_each_pair(x, y, z, i, ranges, count, kernel_->h2, [&](std::size_t j, Real, Real, Real, Real r2) {
-          if (is_boundary(kind[j])) return;
-          const double dx = double(x[j]) - double(x[i]), dy = double(y[j]) - double(y[i]), dz = double(z[j]) - double(z[i]);
-          const double r = std::sqrt(double(r2));
-          if (!(r > 0)) return;
-          const double c = double(m[j]) * double(m[i]) * double(kappa[j]) / double(rho[j]) * double(kernel_->gradient(Real(r)));
-          fx += c * dx, fy += c * dy, fz += c * dz;
-        });
-        const std::size_t at = 3 * std::size_t(p.id[i]);
-        out[at] = fx, out[at + 1] = fy, out[at + 2] = fz;
-      });
-    });
+    if (!kinds(p) || !kernel_) return;
+    if (p.find_field(kKappaField) == ParticleSet<Real>::npos)
+      throw std::logic_error("SPH: the constant-density solve's κ is not declared");
+    std::vector<double> f;
+    auto record = [&](const ParticleSet<Real>& set, IndexRange own) {
+      f.assign(3 * std::size_t(own.end - own.begin), 0.0);
+      density_reaction_on(set, own, block_size, f.data());
+      const std::int32_t* kind = kinds(set);
+      reactions_.clear();
+      for (std::size_t i = own.begin; i < own.end; ++i)
+        if (is_boundary(kind[i])) {
+          const std::size_t at = 3 * (i - own.begin);
+          reactions_.push_back({std::uint64_t(set.id[i]), {f[at], f[at + 1], f[at + 2]}});
+        }
+      std::sort(reactions_.begin(), reactions_.end(),
+                [](const Reaction& a, const Reaction& b) { return a.id < b.id; });
+    };
+    if (!ranks_) {
+      record(p, detail::all_of(p));
+      return;
+    }
+    with_ghosts(p, {"position", "mass", "density", std::string(kKindField), std::string(kKappaField)}, block_size,
+                record);
   }
 
   // The force the fluid exerts on each boundary particle (N; docs/sph.md,
@@ -443,58 +448,29 @@ class SphFluid final : public Solver<Real> {
   // taken at the current x, an approximation); plus the same viscosity. A
   // gather into b over the grid: the same bits for any thread count. Needs a
   // grid evaluation (boundary particles always have one).
-  void boundary_forces(const ParticleSet<Real>& p, std::size_t block_size, std::vector<double>& f) const {
+  // On several ranks (p: this rank's particles) collective, every rank
+  // calling it between the same steps: each rank's own boundary particles
+  // among their ghosts (exchange 1 of what the sum reads, with the current
+  // velocities, through the last evaluation's halo, so the grid's ranges are
+  // its ranges again), the one-rank bits for every particle.
+  void boundary_forces(const ParticleSet<Real>& p, std::size_t block_size, std::vector<double>& f) {
     f.assign(3 * p.size(), 0.0);
-    const std::int32_t* kind = kinds(p);
-    if (!kind || p.empty()) return;
+    if (!kinds(p)) return;
+    if (!ranks_ && p.empty()) return;
     if (!used_grid_ || (dfsph() && !kernel_))
       throw std::logic_error("SPH: boundary forces before an evaluation on the grid");
-    const SphLaws<Real> laws(params_);
-    const double rho0 = params_.rest_density;
-    const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data(), *m = p.mass.data();
-    const Real *vx = p.velocity.x.data(), *vy = p.velocity.y.data(), *vz = p.velocity.z.data();
-    const Real *rho = p.density.data(), *pr = p.pressure.data();
-    const Real *kappa = nullptr, *kappa_v = nullptr;
-    if (dfsph()) {
-      const std::size_t k1 = p.find_field(kKappaField), k2 = p.find_field(kKappaVField);
-      if (k1 == ParticleSet<Real>::npos || k2 == ParticleSet<Real>::npos)
-        throw std::logic_error("SPH: boundary forces without DFSPH's κ fields");
-      kappa = p.extra(k1).data(), kappa_v = p.extra(k2).data();
+    if (dfsph() && (p.find_field(kKappaField) == ParticleSet<Real>::npos ||
+                    p.find_field(kKappaVField) == ParticleSet<Real>::npos))
+      throw std::logic_error("SPH: boundary forces without DFSPH's κ fields");
+    if (!ranks_) {
+      boundary_forces_on(p, detail::all_of(p), block_size, f.data());
+      return;
     }
-    const double norm_p = double(laws.pressure.norm), norm_v = double(laws.viscosity.norm);
-    // Before the first step nothing is recorded, and κ is 0 anyway.
-    const bool recorded = records_boundary_reactions();
-    double* out = f.data();
-    parallel::for_blocks_pinned("sph_boundary_forces", p.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
-      detail::for_each_in_cells(grid_, b, e, [&](std::size_t i, const auto& ranges, int count) {
-        if (!is_boundary(kind[i])) return;
-        const double volume = double(m[i]) / rho0;  // V_b = ψ_b/ρ0
-        double fx = 0, fy = 0, fz = 0;
-        detail::for_each_pair(x, y, z, i, ranges, count, laws.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
-          if (is_boundary(kind[j])) return;
-          // r⃗_jb = x_j − x_b, in double from the same positions.
-          const double dx = double(x[j]) - double(x[i]), dy = double(y[j]) - double(y[i]), dz = double(z[j]) - double(z[i]);
-          const double r = std::sqrt(double(r2)), mj = double(m[j]), rj = double(rho[j]);
-          const double q = std::max(double(laws.h) - r, 0.0);
-          double radial = 0;  // a_j←b = radial · r⃗_jb + viscous · (v_b − v_j)
-          if (dfsph()) {
-            const double k = double(kappa_v[j]) + (recorded ? 0.0 : double(kappa[j]));
-            radial = r > 0 ? -double(m[i]) * k / rj * double(kernel_->gradient(Real(r))) : 0.0;
-          } else {
-            radial = r > 0 ? norm_p * (double(pr[j]) + double(pr[i])) * volume * q * q / r / rj : 0.0;
-          }
-          const double viscous = norm_v * volume * q / rj;
-          fx -= mj * (radial * dx + viscous * (double(vx[i]) - double(vx[j])));
-          fy -= mj * (radial * dy + viscous * (double(vy[i]) - double(vy[j])));
-          fz -= mj * (radial * dz + viscous * (double(vz[i]) - double(vz[j])));
-        });
-        if (recorded) {
-          const std::size_t at = 3 * std::size_t(p.id[i]);
-          if (at + 2 < density_reaction_.size())
-            fx += density_reaction_[at], fy += density_reaction_[at + 1], fz += density_reaction_[at + 2];
-        }
-        out[3 * i] = fx, out[3 * i + 1] = fy, out[3 * i + 2] = fz;
-      });
+    if (records_boundary_reactions()) settle_reactions(p);
+    std::vector<std::string> fields{"position", "velocity", "mass", "density", "pressure", std::string(kKindField)};
+    if (dfsph()) fields.insert(fields.end(), {std::string(kKappaField), std::string(kKappaVField)});
+    with_ghosts(p, fields, block_size, [&](const ParticleSet<Real>& set, IndexRange own) {
+      boundary_forces_on(set, own, block_size, f.data());
     });
   }
 
@@ -611,6 +587,146 @@ class SphFluid final : public Solver<Real> {
   }
 
  private:
+  // A recorded density-solve reaction (record_density_reaction()): a boundary particle's id and F_b.
+  struct Reaction {
+    std::uint64_t id = 0;
+    std::array<double, 3> force{};
+  };
+
+  // record_density_reaction()'s sum for the particles own of `set` (the grid
+  // of the last evaluation indexes `set`), into out[3(i − own.begin)...].
+  void density_reaction_on(const ParticleSet<Real>& set, IndexRange own, std::size_t block_size, double* out) const {
+    const std::int32_t* kind = kinds(set);
+    const std::size_t k1 = set.find_field(kKappaField);
+    const Real *x = set.position.x.data(), *y = set.position.y.data(), *z = set.position.z.data(), *m = set.mass.data();
+    const Real *rho = set.density.data(), *kappa = set.extra(k1).data();
+    const std::size_t from = own.begin;
+    parallel::for_blocks_pinned("sph_boundary_reaction", own.end - own.begin, block_size,
+                                [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_in_cells(grid_, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
+        if (!is_boundary(kind[i])) return;
+        double fx = 0, fy = 0, fz = 0;
+        detail::for_each_pair(x, y, z, i, ranges, count, kernel_->h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (is_boundary(kind[j])) return;
+          const double dx = double(x[j]) - double(x[i]), dy = double(y[j]) - double(y[i]), dz = double(z[j]) - double(z[i]);
+          const double r = std::sqrt(double(r2));
+          if (!(r > 0)) return;
+          const double c = double(m[j]) * double(m[i]) * double(kappa[j]) / double(rho[j]) * double(kernel_->gradient(Real(r)));
+          fx += c * dx, fy += c * dy, fz += c * dz;
+        });
+        const std::size_t at = 3 * (i - from);
+        out[at] = fx, out[at + 1] = fy, out[at + 2] = fz;
+      });
+    });
+  }
+
+  // boundary_forces()' sum for the particles own of `set`, into out[3(i − own.begin)...].
+  void boundary_forces_on(const ParticleSet<Real>& set, IndexRange own, std::size_t block_size, double* out) const {
+    const std::int32_t* kind = kinds(set);
+    const SphLaws<Real> laws(params_);
+    const double rho0 = params_.rest_density;
+    const Real *x = set.position.x.data(), *y = set.position.y.data(), *z = set.position.z.data(), *m = set.mass.data();
+    const Real *vx = set.velocity.x.data(), *vy = set.velocity.y.data(), *vz = set.velocity.z.data();
+    const Real *rho = set.density.data(), *pr = set.pressure.data();
+    const Real *kappa = nullptr, *kappa_v = nullptr;
+    if (dfsph()) kappa = set.extra(set.find_field(kKappaField)).data(), kappa_v = set.extra(set.find_field(kKappaVField)).data();
+    const double norm_p = double(laws.pressure.norm), norm_v = double(laws.viscosity.norm);
+    // Before the first step nothing is recorded, and κ is 0 anyway.
+    const bool recorded = records_boundary_reactions();
+    const std::size_t from = own.begin;
+    parallel::for_blocks_pinned("sph_boundary_forces", own.end - own.begin, block_size,
+                                [&](std::size_t b, std::size_t e, std::size_t) {
+      detail::for_each_in_cells(grid_, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
+        if (!is_boundary(kind[i])) return;
+        const double volume = double(m[i]) / rho0;  // V_b = ψ_b/ρ0
+        double fx = 0, fy = 0, fz = 0;
+        detail::for_each_pair(x, y, z, i, ranges, count, laws.h2, [&](std::size_t j, Real, Real, Real, Real r2) {
+          if (is_boundary(kind[j])) return;
+          // r⃗_jb = x_j − x_b, in double from the same positions.
+          const double dx = double(x[j]) - double(x[i]), dy = double(y[j]) - double(y[i]), dz = double(z[j]) - double(z[i]);
+          const double r = std::sqrt(double(r2)), mj = double(m[j]), rj = double(rho[j]);
+          const double q = std::max(double(laws.h) - r, 0.0);
+          double radial = 0;  // a_j←b = radial · r⃗_jb + viscous · (v_b − v_j)
+          if (dfsph()) {
+            const double k = double(kappa_v[j]) + (recorded ? 0.0 : double(kappa[j]));
+            radial = r > 0 ? -double(m[i]) * k / rj * double(kernel_->gradient(Real(r))) : 0.0;
+          } else {
+            radial = r > 0 ? norm_p * (double(pr[j]) + double(pr[i])) * volume * q * q / r / rj : 0.0;
+          }
+          const double viscous = norm_v * volume * q / rj;
+          fx -= mj * (radial * dx + viscous * (double(vx[i]) - double(vx[j])));
+          fy -= mj * (radial * dy + viscous * (double(vy[i]) - double(vy[j])));
+          fz -= mj * (radial * dz + viscous * (double(vz[i]) - double(vz[j])));
+        });
+        if (recorded) {
+          const std::uint64_t id = set.id[i];
+          const auto it = std::lower_bound(reactions_.begin(), reactions_.end(), id,
+                                           [](const Reaction& r, std::uint64_t v) { return r.id < v; });
+          if (it != reactions_.end() && it->id == id)
+            fx += it->force[0], fy += it->force[1], fz += it->force[2];
+        }
+        const std::size_t at = 3 * (i - from);
+        out[at] = fx, out[at + 1] = fy, out[at + 2] = fz;
+      });
+    });
+  }
+
+  // On ranks, collective: body(set, own) on a copy of this rank's particles p
+  // (as the last evaluation left them in order) among their ghosts, which
+  // carry the named fields (the others zero): exchange 1 through that
+  // evaluation's halo (kept un-inserted in reaction_halo_), so the local
+  // array has the evaluation's layout, and grid_ is that evaluation's view of
+  // it. DFSPH keeps its view (over local_'s keys, which have that layout);
+  // the thesis's solver took its ghosts out after its passes, which left its
+  // view without the keys it reads, so it is made again over this set's (the
+  // same frame, keys and global indices: the same view; it is not used again
+  // before the next evaluation makes its own).
+  template <class Body>
+  void with_ghosts(const ParticleSet<Real>& p, const std::vector<std::string>& fields, std::size_t block_size,
+                   Body&& body) {
+    if (p.size() != reaction_halo_.owned_count())
+      throw std::logic_error("SPH: boundary forces on ranks after the particles changed since the evaluation");
+    ghost_set_ = p;
+    if (dfsph())
+      ghost_keys_.assign(halo_keys_.begin() + own_.begin, halo_keys_.begin() + own_.end);
+    else
+      ghost_keys_ = halo_keys_;
+    reaction_halo_.insert(ranks_->comm(), ghost_set_, ghost_keys_, fields);
+    if (!dfsph()) grid_.view(ranks_->frame(), ghost_keys_, reaction_halo_.global_index(), block_size);
+    body(static_cast<const ParticleSet<Real>&>(ghost_set_), reaction_halo_.owned());
+    reaction_halo_.remove(ghost_set_, ghost_keys_);  // ready for another call before the next evaluation
+    ghost_set_ = ParticleSet<Real>();
+    ghost_keys_ = {};
+  }
+
+  // On ranks, collective: the recorded reactions (record_density_reaction(),
+  // by id, of the particles each rank held then) to the ranks that hold their
+  // particles now: those of particles that left a rank in the sort since are
+  // sent to every rank (an all-gather of 32 B each; a boundary particle moves
+  // only when a cut passes it), and each keeps those it holds.
+  void settle_reactions(const ParticleSet<Real>& p) {
+    const std::int32_t* kind = kinds(p);
+    std::vector<std::uint64_t> mine;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      if (is_boundary(kind[i])) mine.push_back(std::uint64_t(p.id[i]));
+    std::sort(mine.begin(), mine.end());
+    auto held = [&](std::uint64_t id) { return std::binary_search(mine.begin(), mine.end(), id); };
+    std::vector<Reaction> kept, left;
+    for (const Reaction& r : reactions_) (held(r.id) ? kept : left).push_back(r);
+    dist::Bytes bytes(left.size() * sizeof(Reaction));
+    if (!left.empty()) std::memcpy(bytes.data(), left.data(), bytes.size());
+    for (const dist::Bytes& b : ranks_->comm().all_gather(bytes)) {
+      if (b.size() % sizeof(Reaction) != 0) throw std::runtime_error("SPH: a rank sent a partial boundary reaction");
+      for (std::size_t at = 0; at < b.size(); at += sizeof(Reaction)) {
+        Reaction r;
+        std::memcpy(&r, b.data() + at, sizeof(Reaction));
+        if (held(r.id)) kept.push_back(r);
+      }
+    }
+    std::sort(kept.begin(), kept.end(), [](const Reaction& a, const Reaction& b) { return a.id < b.id; });
+    reactions_ = std::move(kept);
+  }
+
   void count_evaluation() {
     neighbour_sum_ += mean_neighbours_;
     ++evaluations_;
@@ -784,6 +900,7 @@ class SphFluid final : public Solver<Real> {
       });
     }
     halo.remove(p, halo_keys_);
+    if (kinds(p)) reaction_halo_ = std::move(halo);  // boundary_forces()
     // The mean over all particles: an exact integer sum, then the one-rank division.
     const std::uint64_t all = comm.sum(pairs);
     mean_neighbours_ = order.global_count() == 0 ? 0.0 : static_cast<double>(all) / static_cast<double>(order.global_count());
@@ -862,6 +979,7 @@ class SphFluid final : public Solver<Real> {
       halo_keys_.assign(order.keys().begin(), order.keys().end());
       halo_ = dist::Halo::find(comm, order.frame(), halo_keys_, order.first_global_index(), order.global_count(),
                                order.cut_keys(), kHaloTail<Real>);
+      if (kinds(p)) reaction_halo_ = halo_;  // before insert(): boundary_forces(), record_density_reaction()
       halo_.insert(comm, local_, halo_keys_, exchange_fields(p));
       own_ = halo_.owned();
     }
@@ -1065,7 +1183,12 @@ class SphFluid final : public Solver<Real> {
   bool boundary_volumes_ = false;  // ψ_b computed into the boundary particles' masses (state)
   bool moving_boundaries_ = false;  // ψ_b recomputed at every evaluation (set_moving_boundaries)
   bool record_reactions_ = false;  // DFSPH: record_density_reaction() after each density solve
-  std::vector<double> density_reaction_;  // DFSPH: its result, 3 per id (scratch: a step recomputes it)
+  std::vector<Reaction> reactions_;  // DFSPH: its result, by id (scratch: a step recomputes it)
+  // On ranks, with boundary particles: the last evaluation's halo (not
+  // inserted) and, while boundary forces are summed, the set with its ghosts.
+  dist::Halo reaction_halo_;
+  ParticleSet<Real> ghost_set_;
+  std::vector<std::uint64_t> ghost_keys_;
   std::size_t fluid_count_ = 0;    // fluid particles at the last evaluation (of all ranks)
 };
 
