@@ -506,8 +506,8 @@ SnapshotFile read_snapshot(const fs::path& path, std::optional<int> part_type) {
   return out;
 }
 
-SnapshotLayout read_snapshot_layout(const fs::path& path) {
-  Opened o = open_snapshot(path, std::nullopt);
+SnapshotLayout read_snapshot_layout(const fs::path& path, std::optional<int> part_type) {
+  Opened o = open_snapshot(path, part_type);
   SnapshotLayout layout;
   layout.time = o.head.info.time;
   layout.type = o.head.info.type;

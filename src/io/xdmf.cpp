@@ -38,10 +38,11 @@ std::string data_item(const XdmfEntry& e, const SnapshotLayout::Dataset& d) {
 
 }  // namespace
 
-std::string xdmf_text(const std::vector<XdmfEntry>& entries) {
+std::string xdmf_text(const std::vector<XdmfEntry>& entries, std::string_view series) {
   std::string x;
   x += "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"2.0\">\n <Domain>\n";
-  x += "  <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  x += fmt::format("  <Grid Name=\"{}\" GridType=\"Collection\" CollectionType=\"Temporal\">\n",
+                   detail::xml_escape(series));
   for (std::size_t f = 0; f < entries.size(); ++f) {
     const XdmfEntry& e = entries[f];
     x += fmt::format("   <Grid Name=\"frame_{}\" GridType=\"Uniform\">\n", f);
@@ -64,7 +65,7 @@ std::string xdmf_text(const std::vector<XdmfEntry>& entries) {
 
 void XdmfSeries::add(const std::string& relative_file, SnapshotLayout layout) {
   entries_.push_back({relative_file, std::move(layout)});
-  write_file_atomic(path_, xdmf_text(entries_));
+  write_file_atomic(path_, xdmf_text(entries_, path_.stem().string()));
 }
 
 }  // namespace swirl::io

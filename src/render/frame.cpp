@@ -6,6 +6,7 @@
 
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/frame_names.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/io/vtp.hpp"
 
@@ -62,7 +63,9 @@ std::string_view quantity_name(Quantity q) {
 namespace {
 // An HDF5 snapshot as a frame: its Gadget datasets by their names.
 Frame load_snapshot_frame(const std::filesystem::path& file) {
-  const io::SnapshotFile s = io::read_snapshot(file);  // checks shapes and finiteness
+  // A boundary frame's particles are type 2; a particle frame's the one type it has.
+  const bool walls = io::frame_index(file, io::kBoundarySeries).has_value();
+  const io::SnapshotFile s = io::read_snapshot(file, walls ? std::optional<int>(int(io::PartType::Boundary)) : std::nullopt);
   Frame f;
   f.file = file;
   f.time = s.info.time;
@@ -78,9 +81,9 @@ Frame load_snapshot_frame(const std::filesystem::path& file) {
     for (const double k : it->second.values) f.kind.push_back(static_cast<std::int32_t>(k));
   return f;
 }
-}  // namespace
 
-Frame load_frame(const std::filesystem::path& file) {
+// One file's particles, nothing added.
+Frame load_one(const std::filesystem::path& file) {
   if (file.extension() == ".h5") return load_snapshot_frame(file);
   const io::VtpFile vtp = io::read_vtp(file);
   Frame f;
@@ -110,6 +113,32 @@ Frame load_frame(const std::filesystem::path& file) {
   for (const Vec3d& p : f.positions)
     if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
       throw io::IoError(file.string() + ": a particle position is not finite");
+  return f;
+}
+
+// Appends `more`'s particles to `to`: a field either frame lacks is dropped,
+// and a frame without kinds is all fluid.
+void append(Frame& to, Frame more) {
+  const std::size_t n = to.positions.size(), m = more.positions.size();
+  if (to.kind.empty()) to.kind.assign(n, std::int32_t(ParticleKind::Fluid));
+  if (more.kind.empty()) more.kind.assign(m, std::int32_t(ParticleKind::Fluid));
+  const auto join = [&](auto& a, auto& b) {
+    if (a.size() == n && b.size() == m) a.insert(a.end(), b.begin(), b.end());
+    else a.clear();
+  };
+  join(to.velocity, more.velocity);
+  join(to.mass, more.mass);
+  join(to.density, more.density);
+  join(to.pressure, more.pressure);
+  join(to.kind, more.kind);
+  to.positions.insert(to.positions.end(), more.positions.begin(), more.positions.end());
+}
+
+}  // namespace
+
+Frame load_frame(const std::filesystem::path& file) {
+  Frame f = load_one(file);
+  if (const auto walls = io::boundary_frame_for(file)) append(f, load_one(*walls));
   return f;
 }
 

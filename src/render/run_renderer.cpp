@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/frame_names.hpp"
 #include "swirl/io/read_file.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/render/png.hpp"
@@ -98,20 +99,6 @@ DensityKernel density_kernel(int height) {
   return k;
 }
 
-// The NNNNNN of a frame stem "particles_NNNNNN", if it is one. (Plain code,
-// not std::regex: GCC 12 warns inside <regex> under the sanitizer build.)
-std::optional<std::uint64_t> frame_number(const std::string& stem) {
-  constexpr std::string_view prefix = "particles_";
-  if (stem.size() <= prefix.size() || stem.compare(0, prefix.size(), prefix) != 0 || stem.size() > prefix.size() + 18)
-    return std::nullopt;
-  std::uint64_t n = 0;
-  for (std::size_t i = prefix.size(); i < stem.size(); ++i) {
-    if (stem[i] < '0' || stem[i] > '9') return std::nullopt;
-    n = n * 10 + static_cast<std::uint64_t>(stem[i] - '0');
-  }
-  return n;
-}
-
 std::string tick_label(double v, bool log_density) {
   if (log_density) return fmt::format("{:.2g}", std::pow(10.0, v));
   return fmt::format("{:.4g}", v);
@@ -132,7 +119,7 @@ RunInfo read_run(const std::filesystem::path& dir) {
     for (const char* extension : {".vtp", ".h5"}) {
       std::vector<std::string> names;
       for (const auto& e : fs::directory_iterator(dir))
-        if (e.is_regular_file() && e.path().extension() == extension && frame_number(e.path().stem().string()))
+        if (e.is_regular_file() && e.path().extension() == extension && io::frame_index(e.path(), io::kParticleSeries))
           names.push_back(e.path().filename().string());
       std::sort(names.begin(), names.end());
       for (auto& n : names) {
@@ -330,7 +317,7 @@ sim::FrameHook render_every(std::filesystem::path run_dir, std::uint64_t every, 
   auto renderer = std::make_shared<std::unique_ptr<RunRenderer>>();
   return [run_dir = std::move(run_dir), every, options, renderer](const std::filesystem::path& frame, double,
                                                                   const sim::ClaimFile& claim) {
-    const auto number = frame_number(frame.stem().string());
+    const auto number = io::frame_index(frame, io::kParticleSeries);
     if (!number || *number % every != 0) return;
     // A .vtp or .h5 frame (the first format written); CSV frames hold too little to draw.
     std::filesystem::path drawn = frame;

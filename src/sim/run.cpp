@@ -20,6 +20,7 @@
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/checkpoint.hpp"
 #include "swirl/io/csv.hpp"
+#include "swirl/io/frame_names.hpp"
 #include "swirl/io/pvd.hpp"
 #include "swirl/io/run_folder.hpp"
 #include "swirl/io/snapshot.hpp"
@@ -40,13 +41,17 @@ namespace {
 // ---------------------------------------------------------------------------
 // Frames: particles_NNNNNN.vtp/.h5/.csv at the output interval, frame 0 at
 // the start, the final state at the end; particles.pvd (VTK frames) and
-// particles.xdmf (HDF5 snapshots) kept current.
+// particles.xdmf (HDF5 snapshots) kept current. Boundary particles
+// (core/particle_kind.hpp) go to their own series, boundary_NNNNNN.* with
+// boundary.pvd and boundary.xdmf (io/frame_names.hpp): with every frame when
+// some obstacle moves, else once, with the first frame (static ones never
+// change: their positions, ψ-weighted masses, ρ0 and zero pressure).
 template <class Real>
 class FrameWriter final : public Observer<Real> {
  public:
   FrameWriter(const scene::Scene& scene, const RunOptions& options, io::RunFolder* folder)
-      : formats_(scene.formats), dir_(options.out_dir), series_(dir_ / "particles.pvd"),
-        snapshots_(dir_ / "particles.xdmf"), snapshot_info_(snapshot_info(scene)),
+      : formats_(scene.formats), dir_(options.out_dir), particles_(dir_, io::kParticleSeries, snapshot_info(scene).type),
+        boundary_(dir_, io::kBoundarySeries, io::PartType::Boundary), snapshot_info_(snapshot_info(scene)),
         schedule_(scene.output_interval, scene.dt), on_frame_(options.on_frame), folder_(folder) {}
 
   std::string_view name() const override { return "frames"; }
@@ -74,24 +79,52 @@ class FrameWriter final : public Observer<Real> {
     frames_ = static_cast<std::size_t>(find_value(values, "frames.written").value_or(0));
     schedule_.set_next_index(static_cast<std::uint64_t>(find_value(values, "frames.next").value_or(1)));
     last_step_ = static_cast<std::uint64_t>(find_value(values, "frames.last_step").value_or(0));
-    if (has(scene::OutputFormat::Hdf5)) {
-      // The series from the snapshots written before the checkpoint (their headers and shapes only).
-      std::vector<io::XdmfEntry> entries;
-      for (std::size_t f = 0; f < frames_; ++f) {
-        const std::string name = snapshot_name(f);
-        if (std::filesystem::exists(dir_ / name)) entries.push_back({name, io::read_snapshot_layout(dir_ / name)});
-      }
-      snapshots_.set_entries(std::move(entries));
-    }
-    const auto pvd = dir_ / "particles.pvd";
-    if (!std::filesystem::exists(pvd)) return;
-    auto entries = io::read_pvd(pvd);
-    if (entries.size() > frames_) entries.resize(frames_);
-    series_.set_entries(std::move(entries));
+    particles_.resume(frames_, has(scene::OutputFormat::Hdf5));
+    boundary_.resume(frames_, has(scene::OutputFormat::Hdf5));
   }
   std::size_t frames() const { return frames_; }
 
  private:
+  // One series of frames (particles or boundary) and its listings.
+  struct Series {
+    Series(const std::filesystem::path& dir, std::string_view series, io::PartType part_type)
+        : name(series), type(part_type), pvd(dir / fmt::format("{}.pvd", series)),
+          xdmf(dir / fmt::format("{}.xdmf", series)) {}
+
+    // The listings as they were with `frames` frames written (a resumed run):
+    // the entries of frames before that index, from the .pvd and, for HDF5,
+    // from the snapshots' headers.
+    void resume(std::size_t frames, bool hdf5) {
+      const std::filesystem::path dir = pvd.path().parent_path();
+      const auto before = [&](const std::string& file) {
+        const auto k = io::frame_index(file, name);
+        return k && *k < frames;
+      };
+      written = 0;
+      if (hdf5) {
+        std::vector<io::XdmfEntry> entries;
+        for (std::size_t f = 0; f < frames; ++f) {
+          const std::string file = io::frame_file_name(name, f, ".h5");
+          if (std::filesystem::exists(dir / file))
+            entries.push_back({file, io::read_snapshot_layout(dir / file, int(type))});
+        }
+        written = std::max(written, entries.size());
+        xdmf.set_entries(std::move(entries));
+      }
+      if (!std::filesystem::exists(pvd.path())) return;
+      auto entries = io::read_pvd(pvd.path());
+      std::erase_if(entries, [&](const io::PvdEntry& e) { return !before(e.file); });
+      written = std::max(written, entries.size());
+      pvd.set_entries(std::move(entries));
+    }
+
+    std::string_view name;
+    io::PartType type;  // in its HDF5 snapshots
+    io::PvdSeries pvd;
+    io::XdmfSeries xdmf;
+    std::size_t written = 0;  // frames of this series so far
+  };
+
   void write(Simulation<Real>& sim) {
     ScopedPhase phase(sim.timers(), "output");
     const ParticleSet<Real>& whole = sim.whole_particles();  // collective on ranks
@@ -100,36 +133,59 @@ class FrameWriter final : public Observer<Real> {
       last_step_ = sim.step_count();
       return;
     }
+    std::filesystem::path first;
+    const std::size_t kind_field = whole.find_int_field(kKindField);
+    std::vector<std::size_t> rest, walls;  // particle indices of the two series
+    if (kind_field != ParticleSet<Real>::npos) {
+      const auto& kind = whole.int_field(kind_field);
+      for (std::size_t i = 0; i < whole.size(); ++i) (is_boundary(kind[i]) ? walls : rest).push_back(i);
+    }
+    if (walls.empty()) {
+      first = write_frame(particles_, whole, sim.time());
+    } else {
+      first = write_frame(particles_, whole.subset(rest), sim.time());
+      const auto* moving = sim.moving_boundaries();
+      if (boundary_.written == 0 || (moving && !moving->empty()))
+        write_frame(boundary_, whole.subset(walls), sim.time());
+    }
+    ++frames_;
+    last_step_ = sim.step_count();
+    io::RunFolder& folder = *folder_;
+    if (on_frame_) on_frame_(first, sim.time(), [&folder](const std::filesystem::path& p) { return folder.claim(p); });
+  }
+
+  // Writes `set` as frame frames_ of `series` in every format; returns the
+  // first format's file.
+  std::filesystem::path write_frame(Series& series, const ParticleSet<Real>& set, double time) {
     io::RunFolder& folder = *folder_;
     std::filesystem::path first;
     for (auto format : formats_) {
       std::filesystem::path file;
       if (format == scene::OutputFormat::Vtp) {
-        const std::string name = fmt::format("particles_{:06d}.vtp", frames_);
+        const std::string name = io::frame_file_name(series.name, frames_, ".vtp");
         file = folder.claim(dir_ / name);
-        io::write_vtp(file, whole, sim.time());
-        folder.claim(dir_ / "particles.pvd");
-        series_.add(sim.time(), name);
+        io::write_vtp(file, set, time);
+        folder.claim(series.pvd.path());
+        series.pvd.add(time, name);
       } else if (format == scene::OutputFormat::Hdf5) {
-        const std::string name = snapshot_name(frames_);
+        const std::string name = io::frame_file_name(series.name, frames_, ".h5");
         file = folder.claim(dir_ / name);
         io::SnapshotInfo info = snapshot_info_;
-        info.time = sim.time();
-        io::SnapshotLayout layout = io::write_snapshot(file, whole, info);
-        folder.claim(snapshots_.path());
-        snapshots_.add(name, std::move(layout));
+        info.time = time;
+        info.type = series.type;
+        io::SnapshotLayout layout = io::write_snapshot(file, set, info);
+        folder.claim(series.xdmf.path());
+        series.xdmf.add(name, std::move(layout));
       } else {
-        file = folder.claim(dir_ / fmt::format("particles_{:06d}.csv", frames_));
-        io::write_csv(file, whole, sim.time());
+        file = folder.claim(dir_ / io::frame_file_name(series.name, frames_, ".csv"));
+        io::write_csv(file, set, time);
       }
       if (first.empty()) first = file;
     }
-    ++frames_;
-    last_step_ = sim.step_count();
-    if (on_frame_) on_frame_(first, sim.time(), [&folder](const std::filesystem::path& p) { return folder.claim(p); });
+    ++series.written;
+    return first;
   }
 
-  static std::string snapshot_name(std::size_t frame) { return fmt::format("particles_{:06d}.h5", frame); }
   bool has(scene::OutputFormat format) const {
     return std::find(formats_.begin(), formats_.end(), format) != formats_.end();
   }
@@ -148,8 +204,7 @@ class FrameWriter final : public Observer<Real> {
 
   std::vector<scene::OutputFormat> formats_;
   std::filesystem::path dir_;
-  io::PvdSeries series_;
-  io::XdmfSeries snapshots_;
+  Series particles_, boundary_;
   io::SnapshotInfo snapshot_info_;
   IntervalSchedule schedule_;
   FrameHook on_frame_;

@@ -17,6 +17,7 @@
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/pvd.hpp"
+#include "swirl/io/frame_names.hpp"
 #include "swirl/io/read_file.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/io/vtp.hpp"
@@ -30,9 +31,7 @@ namespace {
 
 // particles_NNNNNN: the frames `swirl run` writes.
 bool is_frame_name(const fs::path& p, std::string_view extension) {
-  const std::string stem = p.stem().string();
-  if (p.extension() != extension || stem.size() <= 10 || stem.compare(0, 10, "particles_") != 0) return false;
-  return std::all_of(stem.begin() + 10, stem.end(), [](char c) { return c >= '0' && c <= '9'; });
+  return p.extension() == extension && io::frame_index(p, io::kParticleSeries).has_value();
 }
 
 std::vector<ReplayEntry> snapshot_frames(const fs::path& dir) {
@@ -128,7 +127,10 @@ std::string swirl_name(const std::string& gadget) {
 }
 
 ReplayFrame read_snapshot_frame(const fs::path& file) {
-  const io::SnapshotFile s = io::read_snapshot(file);  // checks shapes and finiteness, names the file
+  // A boundary frame's particles are type 2; a particle frame's the one type it has.
+  const bool walls = io::frame_index(file, io::kBoundarySeries).has_value();
+  // read_snapshot checks shapes and finiteness and names the file.
+  const io::SnapshotFile s = io::read_snapshot(file, walls ? std::optional<int>(int(io::PartType::Boundary)) : std::nullopt);
   const auto& c = s.datasets.at("Coordinates");
   const std::vector<float> xyz(c.values.begin(), c.values.end());
   std::vector<NamedArray> arrays;
@@ -170,9 +172,33 @@ RunFrames open_run(const fs::path& dir, ReplayFormat format) {
   return run;
 }
 
-ReplayFrame read_replay_frame(const fs::path& file) {
+namespace {
+
+ReplayFrame read_one(const fs::path& file) {
   if (file.extension() == ".h5") return read_snapshot_frame(file);
   return read_vtp_frame(file);
+}
+
+// Appends `more`'s particles to `to`; a field the two do not share is dropped.
+void append(ReplayFrame& to, ReplayFrame more) {
+  const std::size_t n = to.x.size(), m = more.x.size();
+  std::erase_if(to.fields, [&](auto& f) {
+    const auto it = std::find_if(more.fields.begin(), more.fields.end(), [&](const auto& g) { return g.first == f.first; });
+    if (it == more.fields.end() || f.second.size() != n || it->second.size() != m) return true;
+    f.second.insert(f.second.end(), it->second.begin(), it->second.end());
+    return false;
+  });
+  to.x.insert(to.x.end(), more.x.begin(), more.x.end());
+  to.y.insert(to.y.end(), more.y.begin(), more.y.end());
+  to.z.insert(to.z.end(), more.z.begin(), more.z.end());
+}
+
+}  // namespace
+
+ReplayFrame read_replay_frame(const fs::path& file) {
+  ReplayFrame f = read_one(file);
+  if (const auto walls = io::boundary_frame_for(file)) append(f, read_one(*walls));
+  return f;
 }
 
 namespace {

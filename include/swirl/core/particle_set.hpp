@@ -111,6 +111,29 @@ class ParticleSet {
     return removed;
   }
 
+  // A new set with this one's fields (names, shapes, uses) holding copies of
+  // the particles picked[0], picked[1], ... in that order (each index < size()).
+  ParticleSet subset(std::span<const std::size_t> picked) const {
+    ParticleSet out;
+    for (const auto& e : extra_) out.extra_.push_back({e.name, e.components, e.use, {}});
+    for (const auto& e : int_extra_) out.int_extra_.push_back({e.name, e.use, {}});
+    out.resize(picked.size());
+    // Both sets' arrays are visited in the same order.
+    std::vector<const AlignedVector<Real>*> from;
+    for_each_array([&](const AlignedVector<Real>& a) { from.push_back(&a); });
+    std::vector<const AlignedVector<int_type>*> int_from;
+    for_each_int_array([&](const AlignedVector<int_type>& a) { int_from.push_back(&a); });
+    const auto gather = [&](auto& to, const auto& src) {
+      for (std::size_t k = 0; k < picked.size(); ++k) to[k] = src.at(picked[k]);
+    };
+    std::size_t next = 0;
+    out.for_each_array([&](AlignedVector<Real>& a) { gather(a, *from[next++]); });
+    next = 0;
+    out.for_each_int_array([&](AlignedVector<int_type>& a) { gather(a, *int_from[next++]); });
+    gather(out.id, id);
+    return out;
+  }
+
   // Calls f(AlignedVector<Real>&) for every real array, built-in and extra, in
   // fields() order (component by component). The ids are not included.
   // Allocates nothing (unlike fields()): cheap enough for a per-block pass.

@@ -16,7 +16,10 @@
 //                          in cgs (U_L)" = 100, mass (U_M) = 1000, time (U_t) =
 //                          1, current (U_I) = 1, temperature (U_T) = 1.
 //   /PartType<k>           k = 0 for SPH fluid, 1 for collisionless particles
-//                          (stars, dark matter): datasets Coordinates (N × 3),
+//                          (stars, dark matter), 2 for boundary particles
+//                          (their own files, boundary_NNNNNN.h5: see
+//                          io/frame_names.hpp; Gadget's slot 2 is free for
+//                          this, its "disk" only by convention): datasets Coordinates (N × 3),
 //                          Velocities (N × 3), Masses (N), ParticleIDs (N,
 //                          uint64), then every other output field of the
 //                          ParticleSet (the built-ins by their Gadget names:
@@ -54,7 +57,7 @@ inline constexpr int kSnapshotVersion = 1;
 
 // Gadget's particle types that swirl writes. A file read may hold any of the
 // six (0 to 5; kGadgetTypes), which read_snapshot reports as PartType(k).
-enum class PartType : int { Gas = 0, Collisionless = 1 };
+enum class PartType : int { Gas = 0, Collisionless = 1, Boundary = 2 };
 inline constexpr int kGadgetTypes = 6;
 
 // What a snapshot says beside its particles.
@@ -94,8 +97,9 @@ extern template SnapshotLayout write_snapshot<double>(const std::filesystem::pat
                                                       const SnapshotInfo&);
 
 // The layout of a snapshot file, from its header and dataset shapes only (no
-// values read). Throws IoError as read_snapshot does for what it looks at.
-SnapshotLayout read_snapshot_layout(const std::filesystem::path& path);
+// values read), for the particle type asked for or as read_snapshot chooses.
+// Throws IoError as read_snapshot does for what it looks at.
+SnapshotLayout read_snapshot_layout(const std::filesystem::path& path, std::optional<int> part_type = std::nullopt);
 
 // One dataset read back: `columns` values per particle, row by row, in double
 // (integer datasets converted exactly below 2⁵³).

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "swirl/io/snapshot.hpp"
@@ -38,7 +39,8 @@ class XdmfSeries {
   std::vector<XdmfEntry> entries_;
 };
 
-// The XDMF text for these frames (what XdmfSeries writes).
-std::string xdmf_text(const std::vector<XdmfEntry>& entries);
+// The XDMF text for these frames (what XdmfSeries writes), the temporal
+// collection named `series` (XdmfSeries: the file's stem, "particles" or "boundary").
+std::string xdmf_text(const std::vector<XdmfEntry>& entries, std::string_view series = "particles");
 
 }  // namespace swirl::io

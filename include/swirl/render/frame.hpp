@@ -27,8 +27,11 @@ struct Frame {
   std::vector<std::int32_t> kind;   // core/particle_kind.hpp (fluid 0, boundary 1); empty: all fluid
 };
 
-// Reads a .vtp or .h5 frame (by extension). Throws io::IoError naming the
-// file for a missing, truncated or corrupt file, or a field of the wrong shape.
+// Reads a .vtp or .h5 frame (by extension). A run's particle frame
+// particles_NNNNNN comes with the boundary frame in force at it
+// (io::boundary_frame_for), its particles appended (kind 1): the whole state
+// as the run had it. Throws io::IoError naming the file for a missing,
+// truncated or corrupt file, or a field of the wrong shape.
 Frame load_frame(const std::filesystem::path& file);
 
 // The value of `q` per particle (speed = |velocity|). Throws io::IoError

@@ -74,8 +74,10 @@ struct ReplayFrame {
   std::vector<std::pair<std::string, std::vector<float>>> fields;  // what can colour it, in the order above
 };
 
-// Reads a .vtp or .h5 frame (by its extension). Throws io::IoError naming the
-// file when it cannot be read, or its arrays disagree in length.
+// Reads a .vtp or .h5 frame (by its extension); a run's particle frame comes
+// with the boundary frame in force at it, its particles appended
+// (io::boundary_frame_for). Throws io::IoError naming the file when it cannot
+// be read, or its arrays disagree in length.
 ReplayFrame read_replay_frame(const std::filesystem::path& file);
 
 // Serves `run` until *options.stop (options.threads and start_paused: paused
