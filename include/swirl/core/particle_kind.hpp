@@ -4,9 +4,9 @@
 //
 // A scene with boundary particles (box.walls = "particles", or an obstacle_*
 // source) gives its particle set this field (scene/initial_conditions.hpp);
-// a set without it is all fluid. The field is written to frames (an Int32
-// array "kind": ParaView's Threshold filter on it shows the two apart) and
-// travels with checkpoints and reorders like every integer field.
+// a set without it is all fluid. Frames put boundary particles in their own
+// series, boundary_NNNNNN.* (io/frame_names.hpp), both with an Int32 array
+// "kind"; the field travels with checkpoints and reorders like every integer field.
 //
 // What "boundary" means to the pipeline:
 //  - the simulation zeroes a boundary particle's acceleration after every
