@@ -34,19 +34,6 @@ void for_each_neighbour_cell(const spatial::KeyFrame& f, std::uint64_t cell, Vis
         visit(rows ? (z * ny + y) * nx + x : morton_key(x, y, z));
 }
 
-Bytes to_bytes(const std::vector<std::uint64_t>& values) {
-  Bytes b(values.size() * sizeof(std::uint64_t));
-  if (!values.empty()) std::memcpy(b.data(), values.data(), b.size());
-  return b;
-}
-
-std::vector<std::uint64_t> from_bytes(const Bytes& b) {
-  if (b.size() % sizeof(std::uint64_t) != 0) throw std::runtime_error("halo: a rank sent a partial cell request");
-  std::vector<std::uint64_t> values(b.size() / sizeof(std::uint64_t));
-  if (!values.empty()) std::memcpy(values.data(), b.data(), b.size());
-  return values;
-}
-
 }  // namespace
 
 Traffic Halo::traffic_of(const std::vector<Bytes>& send, int self) {
@@ -98,7 +85,7 @@ Halo Halo::find(const Communicator& comm, const spatial::KeyFrame& frame, std::s
   for (std::size_t o = 0; o < ranks; ++o) {
     std::sort(want[o].begin(), want[o].end());
     want[o].erase(std::unique(want[o].begin(), want[o].end()), want[o].end());
-    requests[o] = to_bytes(want[o]);
+    requests[o] = to_bytes(std::span<const std::uint64_t>(want[o]));
   }
   h.request_traffic_ = traffic_of(requests, h.rank_);
   const std::vector<Bytes> asked = comm.all_to_all(requests);
@@ -113,7 +100,9 @@ Halo Halo::find(const Communicator& comm, const spatial::KeyFrame& frame, std::s
     if (static_cast<int>(s) == h.rank_) continue;
     std::vector<std::uint32_t>& out = h.send_[s];
     // Cells come sorted, so their particles come in increasing memory order.
-    for (const std::uint64_t cell : from_bytes(asked[s])) {
+    std::vector<std::uint64_t> cells;
+    append_values(asked[s], cells, "halo: a cell request");
+    for (const std::uint64_t cell : cells) {
       const std::uint64_t lo = cell << shift, hi = lo | low;
       const auto b = std::lower_bound(keys.begin(), keys.end(), lo);
       const auto e = std::upper_bound(b, keys.end(), hi);

@@ -25,6 +25,11 @@ std::optional<std::uint64_t> frame_index(const fs::path& file, std::string_view 
   return n;
 }
 
+std::optional<int> frame_part_type(const fs::path& frame) {
+  if (frame_index(frame, kBoundarySeries)) return 2;
+  return std::nullopt;
+}
+
 std::optional<fs::path> boundary_frame_for(const fs::path& particles_frame) {
   const auto n = frame_index(particles_frame, kParticleSeries);
   if (!n) return std::nullopt;

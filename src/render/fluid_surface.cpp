@@ -101,7 +101,7 @@ sim::FrameHook surface_frames(std::filesystem::path run_dir, FluidSurface settin
                         "\"vtp\" or \"hdf5\")");
     const fs::path file = surface_path_for(drawn, settings.format);
     if (settings.format == scene::SurfaceFormat::Obj) {
-      write_obj(claim(file), frame_surface(load_frame(drawn), settings), time);
+      write_obj(claim(file), frame_surface(load_frame_file(drawn), settings), time);
       return;
     }
     const std::string name = file.filename().string();
@@ -118,7 +118,7 @@ sim::FrameHook surface_frames(std::filesystem::path run_dir, FluidSurface settin
       std::sort(names.begin(), names.end());
       for (auto& other : names) entries->push_back({other, read_ply(run_dir / other).time});
     }
-    write_ply(claim(file), frame_surface(load_frame(drawn), settings), time);
+    write_ply(claim(file), frame_surface(load_frame_file(drawn), settings), time);
     std::erase_if(*entries, [&](const SeriesEntry& e) { return e.name >= name; });
     entries->push_back({name, time});
     io::write_file_atomic(claim(run_dir / "surface.ply.series"), series_json(*entries));

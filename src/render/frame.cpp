@@ -63,9 +63,7 @@ std::string_view quantity_name(Quantity q) {
 namespace {
 // An HDF5 snapshot as a frame: its Gadget datasets by their names.
 Frame load_snapshot_frame(const std::filesystem::path& file) {
-  // A boundary frame's particles are type 2; a particle frame's the one type it has.
-  const bool walls = io::frame_index(file, io::kBoundarySeries).has_value();
-  const io::SnapshotFile s = io::read_snapshot(file, walls ? std::optional<int>(int(io::PartType::Boundary)) : std::nullopt);
+  const io::SnapshotFile s = io::read_snapshot(file, io::frame_part_type(file));  // checks shapes and finiteness
   Frame f;
   f.file = file;
   f.time = s.info.time;
@@ -82,8 +80,9 @@ Frame load_snapshot_frame(const std::filesystem::path& file) {
   return f;
 }
 
-// One file's particles, nothing added.
-Frame load_one(const std::filesystem::path& file) {
+}  // namespace
+
+Frame load_frame_file(const std::filesystem::path& file) {
   if (file.extension() == ".h5") return load_snapshot_frame(file);
   const io::VtpFile vtp = io::read_vtp(file);
   Frame f;
@@ -116,6 +115,8 @@ Frame load_one(const std::filesystem::path& file) {
   return f;
 }
 
+namespace {
+
 // Appends `more`'s particles to `to`: a field either frame lacks is dropped,
 // and a frame without kinds is all fluid.
 void append(Frame& to, Frame more) {
@@ -137,8 +138,8 @@ void append(Frame& to, Frame more) {
 }  // namespace
 
 Frame load_frame(const std::filesystem::path& file) {
-  Frame f = load_one(file);
-  if (const auto walls = io::boundary_frame_for(file)) append(f, load_one(*walls));
+  Frame f = load_frame_file(file);
+  if (const auto walls = io::boundary_frame_for(file)) append(f, load_frame_file(*walls));
   return f;
 }
 

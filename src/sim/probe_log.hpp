@@ -36,7 +36,6 @@
 
 #include <algorithm>
 #include <array>
-#include <cstring>
 #include <filesystem>
 #include <optional>
 #include <sstream>
@@ -150,20 +149,15 @@ class ProbeLog final : public Observer<Real> {
       if (reaches)
         mine.insert(mine.end(), {p.position.x[j], p.position.y[j], p.position.z[j], p.mass[j], p.density[j], p.pressure[j]});
     }
-    dist::Bytes bytes(mine.size() * sizeof(Real));
-    if (!mine.empty()) std::memcpy(bytes.data(), mine.data(), bytes.size());
-    const std::vector<dist::Bytes> all = comm.gather_to_root(bytes);
-    std::size_t n = 0;
-    for (const dist::Bytes& b : all) n += b.size() / (kReals * sizeof(Real));
-    near_ = ParticleSet<Real>(n);
-    std::size_t i = 0;
-    for (const dist::Bytes& b : all)
-      for (std::size_t at = 0; at + kReals * sizeof(Real) <= b.size(); at += kReals * sizeof(Real), ++i) {
-        Real v[kReals];
-        std::memcpy(v, b.data() + at, sizeof v);
-        near_.position.set(i, Vec3<Real>{v[0], v[1], v[2]});
-        near_.mass[i] = v[3], near_.density[i] = v[4], near_.pressure[i] = v[5];
-      }
+    std::vector<Real> all;
+    for (const dist::Bytes& b : comm.gather_to_root(dist::to_bytes(std::span<const Real>(mine))))
+      dist::append_values(b, all, "probes");
+    near_ = ParticleSet<Real>(all.size() / kReals);
+    for (std::size_t i = 0; i < near_.size(); ++i) {
+      const Real* v = all.data() + kReals * i;
+      near_.position.set(i, Vec3<Real>{v[0], v[1], v[2]});
+      near_.mass[i] = v[3], near_.density[i] = v[4], near_.pressure[i] = v[5];
+    }
     return near_;
   }
 
@@ -199,14 +193,9 @@ class ProbeLog final : public Observer<Real> {
       terms.insert(terms.end(), {double(k), fx, fy, fz, ry * fz - rz * fy, rz * fx - rx * fz, rx * fy - ry * fx});
     }
     if (comm) {
-      dist::Bytes bytes(terms.size() * sizeof(double));
-      if (!terms.empty()) std::memcpy(bytes.data(), terms.data(), bytes.size());
+      const dist::Bytes bytes = dist::to_bytes(std::span<const double>(terms));
       terms.clear();
-      for (const dist::Bytes& b : comm->gather_to_root(bytes)) {
-        const std::size_t at = terms.size();
-        terms.resize(at + b.size() / sizeof(double));
-        if (!b.empty()) std::memcpy(terms.data() + at, b.data(), b.size());
-      }
+      for (const dist::Bytes& b : comm->gather_to_root(bytes)) dist::append_values(b, terms, "obstacle forces");
     }
     std::vector<std::array<double, 6>> sums(obstacles_.size(), std::array<double, 6>{});
     for (std::size_t t = 0; t + kTerm <= terms.size(); t += kTerm) {

@@ -52,6 +52,20 @@ inline void fluid_in_twos(std::size_t count, Boundary&& boundary, One&& one, Two
   if (waiting != count) one(waiting);
 }
 
+// Calls first(q) for q in [q, end) and second(q2) for q2 in [q2, end2), each
+// in its order, interleaved while both last (sph/dfsph_pairs.hpp's
+// detail::side_by_side, with offsets).
+template <class First, class Second>
+inline void side_by_side(std::size_t q, std::size_t end, std::size_t q2, std::size_t end2, First&& first,
+                         Second&& second) {
+  for (; q < end && q2 < end2; ++q, ++q2) {
+    first(q);
+    second(q2);
+  }
+  for (; q < end; ++q) first(q);
+  for (; q2 < end2; ++q2) second(q2);
+}
+
 #if defined(__SSE2__)
 
 using V = __m128;
@@ -129,15 +143,11 @@ void dfsph_change_block_simd(const PackedParticles& p, const PairBlock& block, s
     const std::size_t i = first + k, i2 = first + l;
     const V xi = _mm_load_ps(xm + 4 * i), vi = _mm_load_ps(v + 4 * i);
     const V xi2 = _mm_load_ps(xm + 4 * i2), vi2 = _mm_load_ps(v + 4 * i2);
-    std::size_t q = begin(k), q2 = begin(l);
-    const std::size_t end = block.ends[k], end2 = block.ends[l];
     V sum = _mm_setzero_ps(), sum2 = _mm_setzero_ps();
-    for (; q < end && q2 < end2; ++q, ++q2) {
-      sum = change_term(sum, xi, vi, xm, v, block.j[q], block.g + q);
-      sum2 = change_term(sum2, xi2, vi2, xm, v, block.j[q2], block.g + q2);
-    }
-    for (; q < end; ++q) sum = change_term(sum, xi, vi, xm, v, block.j[q], block.g + q);
-    for (; q2 < end2; ++q2) sum2 = change_term(sum2, xi2, vi2, xm, v, block.j[q2], block.g + q2);
+    side_by_side(
+        begin(k), block.ends[k], begin(l), block.ends[l],
+        [&](std::size_t q) { sum = change_term(sum, xi, vi, xm, v, block.j[q], block.g + q); },
+        [&](std::size_t q) { sum2 = change_term(sum2, xi2, vi2, xm, v, block.j[q], block.g + q); });
     out[i] = _mm_cvtss_f32(sum);
     out[i2] = _mm_cvtss_f32(sum2);
   };
@@ -190,15 +200,11 @@ void dfsph_pressure_block_simd(const PackedParticles& p, const PairBlock& block,
     const std::size_t i = first + k, i2 = first + l;
     const V xi = _mm_load_ps(xm + 4 * i), xi2 = _mm_load_ps(xm + 4 * i2);
     const float ki = k_over_rho[i], ki2 = k_over_rho[i2];
-    std::size_t q = begin(k), q2 = begin(l);
-    const std::size_t end = block.ends[k], end2 = block.ends[l];
     V a = _mm_setzero_ps(), a2 = _mm_setzero_ps();
-    for (; q < end && q2 < end2; ++q, ++q2) {
-      a = pressure_term(a, xi, ki, xm, k_over_rho, block.j[q], block.g + q);
-      a2 = pressure_term(a2, xi2, ki2, xm, k_over_rho, block.j[q2], block.g + q2);
-    }
-    for (; q < end; ++q) a = pressure_term(a, xi, ki, xm, k_over_rho, block.j[q], block.g + q);
-    for (; q2 < end2; ++q2) a2 = pressure_term(a2, xi2, ki2, xm, k_over_rho, block.j[q2], block.g + q2);
+    side_by_side(
+        begin(k), block.ends[k], begin(l), block.ends[l],
+        [&](std::size_t q) { a = pressure_term(a, xi, ki, xm, k_over_rho, block.j[q], block.g + q); },
+        [&](std::size_t q) { a2 = pressure_term(a2, xi2, ki2, xm, k_over_rho, block.j[q], block.g + q); });
     apply(i, lane(a, 0), lane(a, 1), lane(a, 2));
     apply(i2, lane(a2, 0), lane(a2, 1), lane(a2, 2));
   };

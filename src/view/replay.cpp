@@ -127,10 +127,8 @@ std::string swirl_name(const std::string& gadget) {
 }
 
 ReplayFrame read_snapshot_frame(const fs::path& file) {
-  // A boundary frame's particles are type 2; a particle frame's the one type it has.
-  const bool walls = io::frame_index(file, io::kBoundarySeries).has_value();
   // read_snapshot checks shapes and finiteness and names the file.
-  const io::SnapshotFile s = io::read_snapshot(file, walls ? std::optional<int>(int(io::PartType::Boundary)) : std::nullopt);
+  const io::SnapshotFile s = io::read_snapshot(file, io::frame_part_type(file));
   const auto& c = s.datasets.at("Coordinates");
   const std::vector<float> xyz(c.values.begin(), c.values.end());
   std::vector<NamedArray> arrays;

@@ -18,13 +18,36 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <span>
+#include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace swirl::dist {
 
 using Bytes = std::vector<std::byte>;
+
+// Trivially copyable values as a message, and back: what a rank sends is an
+// array of records (ids, reals, small structs) copied byte for byte.
+template <class T>
+Bytes to_bytes(std::span<const T> values) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  Bytes b(values.size_bytes());
+  if (!values.empty()) std::memcpy(b.data(), values.data(), b.size());
+  return b;
+}
+// Appends the records of message `b` to `out`. Throws std::runtime_error
+// naming `what` when b is not a whole number of records.
+template <class T>
+void append_values(const Bytes& b, std::vector<T>& out, const char* what) {
+  static_assert(std::is_trivially_copyable_v<T>);
+  if (b.size() % sizeof(T) != 0) throw std::runtime_error(std::string(what) + ": a rank sent a partial record");
+  const std::size_t at = out.size();
+  out.resize(at + b.size() / sizeof(T));
+  if (!b.empty()) std::memcpy(out.data() + at, b.data(), b.size());
+}
 
 class Communicator {
  public:

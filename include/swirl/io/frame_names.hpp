@@ -29,6 +29,10 @@ std::string frame_file_name(std::string_view series, std::uint64_t index, std::s
 // the name is not one (at most 18 digits).
 std::optional<std::uint64_t> frame_index(const std::filesystem::path& file, std::string_view series);
 
+// The Gadget particle type to read from a frame's .h5 file: 2 (PartType2) for
+// a boundary frame; nullopt (the one type the file has) for any other.
+std::optional<int> frame_part_type(const std::filesystem::path& frame);
+
 // The boundary frame in force at a particle frame particles_NNNNNN<ext>:
 // boundary_MMMMMM<ext> in the same directory with the largest M ≤ N; nullopt
 // when there is none or `particles_frame` is not named as a particle frame.

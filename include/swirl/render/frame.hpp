@@ -33,6 +33,8 @@ struct Frame {
 // as the run had it. Throws io::IoError naming the file for a missing,
 // truncated or corrupt file, or a field of the wrong shape.
 Frame load_frame(const std::filesystem::path& file);
+// The particles of that one file only (a particle frame without its boundary frame).
+Frame load_frame_file(const std::filesystem::path& file);
 
 // The value of `q` per particle (speed = |velocity|). Throws io::IoError
 // naming the file when the frame does not have the field.

@@ -222,6 +222,19 @@ inline void fluid_in_twos(std::size_t b, std::size_t e, Boundary&& boundary, One
   if (waiting != e) one(waiting);
 }
 
+// Calls first(q) for q < n and second(q) for q < n2, each in its order, the
+// two interleaved while both last: two independent chains of FMAs in flight.
+template <class First, class Second>
+inline void side_by_side(std::size_t n, std::size_t n2, First&& first, Second&& second) {
+  const std::size_t both = n < n2 ? n : n2;
+  for (std::size_t q = 0; q < both; ++q) {
+    first(q);
+    second(q);
+  }
+  for (std::size_t q = both; q < n; ++q) first(q);
+  for (std::size_t q = both; q < n2; ++q) second(q);
+}
+
 }  // namespace detail
 
 // out[i] = (Dρ/Dt)_i = Σ_j m_j (v_i − v_j)·∇W_ij over i's kept pairs, for i in
@@ -271,14 +284,9 @@ void dfsph_density_change(DfsphPairs<Real>& pairs, const ParticleSet<Real>& p, s
     const auto two = [&](std::size_t k, std::size_t l) {
       const std::size_t i = from + k, i2 = from + l;
       const auto list = pairs.list(k), list2 = pairs.list(l);
-      const std::size_t both = std::min(list.size, list2.size);
       Real sum = 0, sum2 = 0;
-      for (std::size_t q = 0; q < both; ++q) {
-        sum = add(sum, i, list, q);
-        sum2 = add(sum2, i2, list2, q);
-      }
-      for (std::size_t q = both; q < list.size; ++q) sum = add(sum, i, list, q);
-      for (std::size_t q = both; q < list2.size; ++q) sum2 = add(sum2, i2, list2, q);
+      detail::side_by_side(list.size, list2.size, [&](std::size_t q) { sum = add(sum, i, list, q); },
+                           [&](std::size_t q) { sum2 = add(sum2, i2, list2, q); });
       out[i] = sum;
       out[i2] = sum2;
     };
@@ -340,14 +348,9 @@ void dfsph_pressure_velocity(DfsphPairs<Real>& pairs, ParticleSet<Real>& p, std:
       const std::size_t i = from + k, i2 = from + l;
       const auto list = pairs.list(k), list2 = pairs.list(l);
       const Real ki = k_over_rho[i], ki2 = k_over_rho[i2];
-      const std::size_t both = std::min(list.size, list2.size);
       Sum a, a2;
-      for (std::size_t q = 0; q < both; ++q) {
-        add(a, i, ki, list, q);
-        add(a2, i2, ki2, list2, q);
-      }
-      for (std::size_t q = both; q < list.size; ++q) add(a, i, ki, list, q);
-      for (std::size_t q = both; q < list2.size; ++q) add(a2, i2, ki2, list2, q);
+      detail::side_by_side(list.size, list2.size, [&](std::size_t q) { add(a, i, ki, list, q); },
+                           [&](std::size_t q) { add(a2, i2, ki2, list2, q); });
       apply(i, a);
       apply(i2, a2);
     };

@@ -137,7 +137,6 @@
 #include <span>
 #include <cstddef>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -713,16 +712,11 @@ class SphFluid final : public Solver<Real> {
     auto held = [&](std::uint64_t id) { return std::binary_search(mine.begin(), mine.end(), id); };
     std::vector<Reaction> kept, left;
     for (const Reaction& r : reactions_) (held(r.id) ? kept : left).push_back(r);
-    dist::Bytes bytes(left.size() * sizeof(Reaction));
-    if (!left.empty()) std::memcpy(bytes.data(), left.data(), bytes.size());
-    for (const dist::Bytes& b : ranks_->comm().all_gather(bytes)) {
-      if (b.size() % sizeof(Reaction) != 0) throw std::runtime_error("SPH: a rank sent a partial boundary reaction");
-      for (std::size_t at = 0; at < b.size(); at += sizeof(Reaction)) {
-        Reaction r;
-        std::memcpy(&r, b.data() + at, sizeof(Reaction));
-        if (held(r.id)) kept.push_back(r);
-      }
-    }
+    std::vector<Reaction> moved;
+    for (const dist::Bytes& b : ranks_->comm().all_gather(dist::to_bytes(std::span<const Reaction>(left))))
+      dist::append_values(b, moved, "SPH: boundary reactions");
+    for (const Reaction& r : moved)
+      if (held(r.id)) kept.push_back(r);
     std::sort(kept.begin(), kept.end(), [](const Reaction& a, const Reaction& b) { return a.id < b.id; });
     reactions_ = std::move(kept);
   }
