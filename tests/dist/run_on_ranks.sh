@@ -27,16 +27,42 @@ on_ranks() {  # on_ranks N ARGS...: swirl on N ranks (1: without mpirun); status
   fi
   status=$?
 }
-# same_files REF DIR WHAT: every frame, the diagnostics, probes.csv (when REF
-# has one) and every checkpoint of REF, byte for byte in DIR.
+# same_files REF DIR WHAT: every frame (the boundary particles' too), the
+# diagnostics, probes.csv (when REF has one) and every checkpoint of REF, byte
+# for byte in DIR.
 same_files() {
   local ref=$1 dir=$2 what=$3 f n=0
-  for f in "$ref"/particles_*.vtp "$ref"/particles.pvd "$ref"/diagnostics.csv "$ref"/probes.csv "$ref"/checkpoints/*.swc; do
+  for f in "$ref"/particles_*.vtp "$ref"/particles.pvd "$ref"/boundary_*.vtp "$ref"/boundary.pvd \
+           "$ref"/diagnostics.csv "$ref"/probes.csv "$ref"/checkpoints/*.swc; do
     [ -e "$f" ] || continue
     n=$((n + 1))
     cmp -s "$f" "$dir/${f#"$ref"/}" || fail "$what: ${f#"$ref"/} differs from the one-rank file"
   done
   [ "$n" -ge 4 ] || fail "$what: the one-rank run wrote only $n files to compare"
+}
+
+# against_one NAME WHAT FILES ARGS...: `swirl run ARGS` for 30 steps
+# (checkpoints every 10) on 1, 2 and 3 ranks, the runs on several ranks
+# compared with same_files; then on 3 ranks to step 17 (checkpoints every 5)
+# resumed on 2 from step 15, and FILES (space-separated) compared with the
+# one-rank run's.
+against_one() {
+  local name=$1 what=$2 files=$3 n f; shift 3
+  on_ranks 1 run "$@" --steps 30 --checkpoint-every-steps 10 --out "$out/${name}_1"
+  [ "$status" -eq 0 ] || { fail "$what on 1 rank: status $status"; cat "$out/stderr"; }
+  for n in 2 3; do
+    on_ranks "$n" run "$@" --steps 30 --checkpoint-every-steps 10 --out "$out/${name}_$n"
+    [ "$status" -eq 0 ] || { fail "$what on $n ranks: status $status"; cat "$out/stderr"; }
+    same_files "$out/${name}_1" "$out/${name}_$n" "$what on $n ranks"
+  done
+  local dir="$out/${name}_resume_3_2"
+  on_ranks 3 run "$@" --steps 17 --checkpoint-every-steps 5 --out "$dir"
+  [ "$status" -eq 0 ] || { fail "$what resume 3 -> 2: the first part: status $status"; cat "$out/stderr"; }
+  on_ranks 2 run --resume "$dir" --steps 15 --checkpoint-every-steps 10
+  [ "$status" -eq 0 ] || { fail "$what resume 3 -> 2: status $status"; cat "$out/stderr"; }
+  for f in $files; do
+    cmp -s "$out/${name}_1/$f" "$dir/$f" || fail "$what resume 3 -> 2 ranks: $f differs from the uninterrupted one-rank run"
+  done
 }
 
 # About 1 900 particles (spacing 3 cm), 30 steps, a frame every 10 steps.
@@ -107,21 +133,8 @@ same_files "$out/drop_1" "$out/drop_3" "SPH with self-gravity on 3 ranks"
 obstacle=("$examples/dam_break_obstacle.toml" --set particles.0.spacing=0.1 --set output.interval=0.05
           --set output.probes_interval=0.02 --set 'simulation.precision="double"' --set simulation.dt_max=0.01
           --set sph.dfsph.density_tolerance=2e-5 --set sph.dfsph.divergence_tolerance=2e-5)
-on_ranks 1 run "${obstacle[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/dfsph_1"
-[ "$status" -eq 0 ] || { fail "dfsph on 1 rank: status $status"; cat "$out/stderr"; }
-for n in 2 3; do
-  on_ranks "$n" run "${obstacle[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/dfsph_$n"
-  [ "$status" -eq 0 ] || { fail "dfsph on $n ranks: status $status"; cat "$out/stderr"; }
-  same_files "$out/dfsph_1" "$out/dfsph_$n" "dfsph with boundary particles on $n ranks"
-done
-dir="$out/dfsph_resume_3_2"
-on_ranks 3 run "${obstacle[@]}" --steps 17 --checkpoint-every-steps 5 --out "$dir"
-[ "$status" -eq 0 ] || { fail "dfsph resume 3 -> 2: the first part: status $status"; cat "$out/stderr"; }
-on_ranks 2 run --resume "$dir" --steps 15 --checkpoint-every-steps 10
-[ "$status" -eq 0 ] || { fail "dfsph resume 3 -> 2: status $status"; cat "$out/stderr"; }
-for f in particles_000003.vtp diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc; do
-  cmp -s "$out/dfsph_1/$f" "$dir/$f" || fail "dfsph resume 3 -> 2 ranks: $f differs from the uninterrupted one-rank run"
-done
+against_one dfsph "dfsph with boundary particles" \
+  "particles_000003.vtp diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc" "${obstacle[@]}"
 # 4c. The same with DFSPH's XSPH filter, surface tension and adhesion on
 #     (docs/sph.md): the ghosts' velocities, densities and surface normals
 #     refreshed; 3 ranks against one, and the terms did change the run.
@@ -152,21 +165,9 @@ awk -F, 'NR > 1 && $2 != 0 && $3 != 0 && $4 != 0 { ok = 1 } END { exit !ok }' "$
 #     cuts as it rolls: the density solve's recorded reactions follow them.
 slosh=("$examples/sloshing.toml" --set particles.1.motion.ramp=0 --set particles.1.motion.amplitude_deg=8
        --set particles.1.motion.frequency=2 --set output.interval=0.05)
-on_ranks 1 run "${slosh[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/moving_1"
-[ "$status" -eq 0 ] || { fail "moving obstacle on 1 rank: status $status"; cat "$out/stderr"; }
-for n in 2 3; do
-  on_ranks "$n" run "${slosh[@]}" --steps 30 --checkpoint-every-steps 10 --out "$out/moving_$n"
-  [ "$status" -eq 0 ] || { fail "moving obstacle on $n ranks: status $status"; cat "$out/stderr"; }
-  same_files "$out/moving_1" "$out/moving_$n" "a moving obstacle with probes on $n ranks"
-done
-dir="$out/moving_resume_3_2"
-on_ranks 3 run "${slosh[@]}" --steps 17 --checkpoint-every-steps 5 --out "$dir"
-[ "$status" -eq 0 ] || { fail "moving obstacle resume 3 -> 2: the first part: status $status"; cat "$out/stderr"; }
-on_ranks 2 run --resume "$dir" --steps 15 --checkpoint-every-steps 10
-[ "$status" -eq 0 ] || { fail "moving obstacle resume 3 -> 2: status $status"; cat "$out/stderr"; }
-for f in particles_000001.vtp diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc; do
-  cmp -s "$out/moving_1/$f" "$dir/$f" || fail "moving obstacle resume 3 -> 2 ranks: $f differs from the uninterrupted one-rank run"
-done
+against_one moving "a moving obstacle with probes" \
+  "particles_000001.vtp boundary_000001.vtp boundary.pvd diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc" \
+  "${slosh[@]}"
 
 # 5. A blow-up (a step far beyond the CFL limit) on 3 ranks: status 1, the
 #    one-rank message exactly, printed once; frame 0 kept.
