@@ -57,23 +57,29 @@ def reexec_with_preload() -> None:
 
 
 def read_frame(path: Path):
-    """(fluid positions, fluid masses, boundary positions) of a swirl CSV frame."""
+    """(fluid positions, fluid masses, boundary positions) of a swirl CSV frame: particles_NNNNNN.csv
+    and, since swirl writes boundary particles to their own series, boundary_NNNNNN.csv beside it
+    (older frames held both kinds in one file, told apart by the kind field)."""
     fluid, masses, walls = [], [], []
-    with open(path, newline="") as f:
-        first = f.readline()
-        if not first.startswith("#"):
-            f.seek(0)
-        reader = csv.reader(f)
-        header = next(reader)
-        ix, iy, iz = header.index("x"), header.index("y"), header.index("z")
-        im, ik = header.index("mass"), header.index("kind")
-        for row in reader:
-            p = (row[ix], row[iy], row[iz])
-            if row[ik] == "0":
-                fluid.append(p)
-                masses.append(float(row[im]))
-            else:
-                walls.append(p)
+    boundary = path.with_name(path.name.replace("particles_", "boundary_", 1))
+    for file in [path] + ([boundary] if boundary != path and boundary.exists() else []):
+        with open(file, newline="") as f:
+            first = f.readline()
+            if not first.startswith("#"):
+                f.seek(0)
+            reader = csv.reader(f)
+            header = next(reader)
+            ix, iy, iz = header.index("x"), header.index("y"), header.index("z")
+            im, ik = header.index("mass"), header.index("kind")
+            for row in reader:
+                p = (row[ix], row[iy], row[iz])
+                if row[ik] == "0":
+                    fluid.append(p)
+                    masses.append(float(row[im]))
+                else:
+                    walls.append(p)
+    if not walls:
+        raise SystemExit(f"{path}: no boundary particles (kind != 0) in it or in {boundary.name}")
     return fluid, masses, walls
 
 

@@ -73,7 +73,7 @@ async function run(n, mode, secs) {
   if (mode === "chromium")  // started first, so that the page connects right after the set-up
     browser = await puppeteer.launch({ executablePath: chromiumPath, headless: true, args: chromiumArgs,
       defaultViewport: { width: 1280, height: 800 } }), page = await browser.newPage(), children.add(browser.process());
-  const swirl = spawn(swirlPath, ["view", path.join(root, "examples/dam_break.toml"), "--port", "0", "--seconds", String(secs),
+  const swirl = spawn(swirlPath, ["view", path.join(root, "examples/dam_break.toml"), "--open", "never", "--port", "0", "--seconds", String(secs),
     "--threads", threads, "--surface-cell", surfaceCell, ...o], { stdio: ["ignore", "pipe", "pipe"] });
   children.add(swirl);
   let out = "", err = "";

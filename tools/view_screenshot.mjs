@@ -25,7 +25,7 @@ const here = path.dirname(fileURLToPath(import.meta.url));
 const require = createRequire(path.join(here, "..", "tests", "browser", "package.json"));
 const puppeteer = require("puppeteer-core");
 
-const swirl = spawn(swirlPath, ["view", scenePath, "--port", "0", "--threads", "2", ...sets],
+const swirl = spawn(swirlPath, ["view", scenePath, "--open", "never", "--port", "0", "--threads", "2", ...sets],
   { stdio: ["ignore", "pipe", "inherit"] });
 let stdout = "";
 swirl.stdout.on("data", (d) => { stdout += d; });

@@ -264,7 +264,7 @@ function onText(text) {
       if (!scrubbing && !seek) ui("slider").value = m.frame;
       return;
     }
-    state.history.push({ e: m.kinetic_energy + m.potential_energy, rate: m.steps_per_second });
+    state.history.push({ e: m.kinetic_energy + m.potential_energy, rate: m.steps_per_second, err: densityError(m) });
     if (state.history.length > 240) state.history.shift();
     ui("stats").textContent = `step ${m.step} · t = ${Number(m.time).toPrecision(4)} · ${m.steps_per_second.toFixed(1)} steps/s · ` +
       `${state.fps.toFixed(0)} fps` + (m.at_end ? " · end of run" : "") + surfaceText(m);
@@ -362,18 +362,34 @@ function sendParameter(id, v) {
   const b = new DataView(new ArrayBuffer(14)); b.setUint8(0, 9); b.setUint8(1, id);
   v.forEach((x, i) => b.setFloat32(2 + 4 * i, x, true)); send(b.buffer);
 }
+// The fluid's density error from a status's diagnostics (diagnostics.csv's columns): DFSPH's own
+// average compression when it runs, else the mean |ρ − ρ0|/ρ0; undefined without a fluid.
+function densityError(m) {
+  const d = m.diagnostics || {};
+  return Number.isFinite(d.dfsph_density_error) ? d.dfsph_density_error : d.mean_density_error;
+}
+// Three bands, each scaled to its own range over the last 240 statuses, labelled with the newest value.
 function plot() {
   const c = ui("plot"), g = c.getContext("2d"); g.clearRect(0, 0, c.width, c.height);
   const h = state.history; if (h.length < 2) return;
-  const line = (key, colour, y0, y1) => {
-    const vs = h.map((x) => x[key]).filter(Number.isFinite); if (!vs.length) return;
+  const band = (key, label, text, colour, y0) => {
+    const y1 = y0 + 36, vs = h.map((x) => x[key]).filter(Number.isFinite);
+    g.fillStyle = "#889";
+    g.fillText(vs.length ? `${label} ${text(vs[vs.length - 1])}` : `${label}: none in this run`, 4, y0 - 2);
+    if (!vs.length) return;
     const lo = Math.min(...vs), hi = Math.max(...vs), span = hi - lo || 1;
     g.strokeStyle = colour; g.beginPath();
-    h.forEach((x, i) => { const px = (i / (h.length - 1)) * c.width, py = y1 - ((x[key] - lo) / span) * (y1 - y0); i ? g.lineTo(px, py) : g.moveTo(px, py); });
+    let first = true;
+    h.forEach((x, i) => {
+      if (!Number.isFinite(x[key])) return;
+      const px = (i / (h.length - 1)) * c.width, py = y1 - ((x[key] - lo) / span) * (y1 - y0);
+      first ? g.moveTo(px, py) : g.lineTo(px, py); first = false;
+    });
     g.stroke();
   };
-  g.fillStyle = "#889"; g.fillText("energy", 4, 12); g.fillText("steps/s", 4, 66);
-  line("e", "#6cf", 14, 52); line("rate", "#fc6", 68, 106);
+  band("e", "energy", (v) => v.toPrecision(4), "#6cf", 14);
+  band("err", "density error", (v) => `${(100 * v).toPrecision(3)} %`, "#9e6", 66);
+  band("rate", "steps/s", (v) => v.toFixed(1), "#fc6", 118);
 }
 
 // ---- Controls back ---------------------------------------------------------------

@@ -4,10 +4,17 @@
 // (view/replay.hpp). The URL is printed; Ctrl-C ends the session.
 // Listening beyond 127.0.0.1 (--host) needs a token in the URL, made here from
 // the system's random device, so that only whoever was given the URL can use it.
+// The page is opened in the user's browser when one is at hand (--open).
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -43,7 +50,51 @@ struct ViewArgs {
   double surface_cell = 1.0;  // the view's surface grid cell, particle spacings
   double seconds = 0;  // stop after this many wall seconds (0: run until Ctrl-C)
   std::string format = "auto";  // replay: the frames to read (auto, vtp, h5)
+  std::string open = "auto";    // open the page in a browser: auto, always, never
 };
+
+extern "C" char** environ;
+
+// Opens `url` in the user's browser without waiting for it: $BROWSER's first
+// entry (the common convention: a command, "%s" standing for the URL), else
+// xdg-open (or macOS's open). "auto" opens only where a graphical session is
+// at hand (DISPLAY or WAYLAND_DISPLAY; always on macOS): over SSH the URL is
+// printed instead, for a browser at the other end of a forwarded port. What
+// happened is returned, for the terminal (empty when nothing was tried).
+std::string open_in_browser(const std::string& url, const std::string& mode) {
+  const auto env = [](const char* name) { const char* v = std::getenv(name); return std::string(v ? v : ""); };
+#ifdef __APPLE__
+  const bool graphical = true;
+  const std::string opener = "open";
+#else
+  const bool graphical = !env("DISPLAY").empty() || !env("WAYLAND_DISPLAY").empty();
+  const std::string opener = "xdg-open";
+#endif
+  if (mode == "never" || (mode == "auto" && !graphical)) return {};
+  std::string browser = env("BROWSER");
+  browser = browser.substr(0, browser.find(':'));
+  std::vector<std::string> argv;
+  if (browser.empty()) argv = {opener, url};
+  else if (const auto at = browser.find("%s"); at != std::string::npos)
+    argv = {"/bin/sh", "-c", browser.replace(at, 2, url)};  // the URL is ours: no quoting needed
+  else argv = {browser, url};
+  std::vector<char*> raw;
+  for (auto& a : argv) raw.push_back(a.data());
+  raw.push_back(nullptr);
+  // The browser's own chatter stays out of swirl's terminal.
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDIN_FILENO, "/dev/null", O_RDONLY, 0);
+  posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  pid_t pid = 0;
+  const int failed = posix_spawnp(&pid, raw[0], &files, nullptr, raw.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  if (failed) return fmt::format("could not start {} ({}): open the URL above yourself", argv[0], std::strerror(failed));
+  // Reaped on its own thread: xdg-open returns once the browser has the URL; a browser itself may run on.
+  std::thread([pid] { int status = 0; ::waitpid(pid, &status, 0); }).detach();
+  return fmt::format("opened in {}", browser.empty() ? opener : argv[0]);
+}
 
 std::string random_token() {
   std::random_device device;
@@ -88,6 +139,9 @@ int view(const ViewArgs& args) {
                  server.url());
     else
       fmt::print("swirl view: {} live at {}\n(Ctrl-C ends the session)\n", args.scene, server.url());
+    std::fflush(stdout);
+    if (const std::string opened = open_in_browser(server.url(), args.open); !opened.empty())
+      fmt::print("swirl view: {}\n", opened);
     std::fflush(stdout);
   };
   g_view_stop.store(false);
@@ -163,6 +217,9 @@ void add_view_command(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(0.05, 4.0));
   cmd->add_option("--format", args->format, "Replay: the frames to read, vtp (particles.pvd) or h5 (snapshots); auto: vtp when present")
       ->check(CLI::IsMember({"auto", "vtp", "h5"}));
+  cmd->add_option("--open", args->open,
+                  "Open the page in a browser ($BROWSER, else xdg-open): auto (where a display is at hand), always, never")
+      ->check(CLI::IsMember({"auto", "always", "never"}));
   cmd->add_option("--seconds", args->seconds, "End the session after this many wall-clock seconds (0: at Ctrl-C)")
       ->check(CLI::NonNegativeNumber);
   commands.push_back({cmd, [args] { return view(*args); }});

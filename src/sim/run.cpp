@@ -32,6 +32,7 @@
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/footprint.hpp"
 #include "swirl/sim/inlets_outlets.hpp"
+#include "swirl/sim/mechanics.hpp"
 #include "swirl/sim/observer.hpp"
 #include "probe_log.hpp"
 
@@ -297,7 +298,7 @@ class DiagnosticsLog final : public Observer<Real> {
       last_step_ = sim.step_count();
       return;
     }
-    const Mechanics m = mechanics(p);
+    const Mechanics m = mechanics(p, block_size_);
     double potential = 0;
     for (const auto& s : sim.solvers()) potential += s->potential_energy(p, block_size_);
     const double total = m.kinetic + potential;
@@ -308,8 +309,7 @@ class DiagnosticsLog final : public Observer<Real> {
       row.push_back(energy_error_);
     }
     row.insert(row.end(), {m.momentum[0], m.momentum[1], m.momentum[2], m.angular[0], m.angular[1], m.angular[2]});
-    for (const auto& s : sim.solvers()) s->add_diagnostics(p, block_size_, row);
-    sim.stepper().add_diagnostics(row);
+    for (const auto& column : diagnostic_values(sim, p, block_size_)) row.push_back(column.second);
     for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
     if (adaptive_) {
       const bool stepped = frame_dt_max_ > 0;
@@ -337,39 +337,6 @@ class DiagnosticsLog final : public Observer<Real> {
     return tight.dt <= dt_max_ ? tight.condition : std::string_view("dt_max");
   }
 
-  struct Mechanics {
-    double kinetic = 0;
-    std::array<double, 3> momentum{}, angular{};
-  };
-  // K = ½ Σ m|v|², P = Σ m v, L = Σ m x × v: in double per block, folded in
-  // block order (the same bits for any thread count). Boundary particles are
-  // left out: their "mass" is a volume weight ψ, and a moving obstacle's
-  // prescribed velocity is not the fluid's (static ones would add zeros).
-  Mechanics mechanics(const ParticleSet<Real>& p) const {
-    using Partial = std::array<double, 7>;
-    const std::size_t kinds = p.find_int_field(kKindField);
-    const std::int32_t* kind = kinds == ParticleSet<Real>::npos ? nullptr : p.int_field(kinds).data();
-    const Partial t = parallel::reduce_blocks(
-        "mechanics", p.size(), block_size_, Partial{},
-        [&](std::size_t b, std::size_t e) {
-          Partial s{};
-          for (std::size_t i = b; i < e; ++i) {
-            if (kind && is_boundary(kind[i])) continue;
-            const double m = p.mass[i];
-            const double x = p.position.x[i], y = p.position.y[i], z = p.position.z[i];
-            const double vx = p.velocity.x[i], vy = p.velocity.y[i], vz = p.velocity.z[i];
-            s[0] += 0.5 * m * (vx * vx + vy * vy + vz * vz);
-            s[1] += m * vx, s[2] += m * vy, s[3] += m * vz;
-            s[4] += m * (y * vz - z * vy), s[5] += m * (z * vx - x * vz), s[6] += m * (x * vy - y * vx);
-          }
-          return s;
-        },
-        [](Partial a, const Partial& b) {
-          for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
-          return a;
-        });
-    return {t[0], {t[1], t[2], t[3]}, {t[4], t[5], t[6]}};
-  }
 
   std::filesystem::path path_;
   IntervalSchedule schedule_;

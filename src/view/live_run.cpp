@@ -18,6 +18,7 @@
 #include "swirl/parallel/for_blocks.hpp"
 #include "swirl/render/fluid_surface.hpp"
 #include "swirl/sim/build.hpp"
+#include "swirl/sim/mechanics.hpp"
 #include "swirl/view/parameters.hpp"
 #include "swirl/view/push_force.hpp"
 
@@ -327,19 +328,20 @@ class LiveSession {
     const double dt = std::chrono::duration<double>(now - status_clock_).count();
     const double rate = dt > 0 ? double(steps_ - status_steps_) / dt : 0;
     status_clock_ = now, status_steps_ = steps_;
+    // The numbers of the run's diagnostics.csv (sim/mechanics.hpp), for the page's plots.
     const auto& p = sim_->particles();
-    double kinetic = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const double vx = p.velocity.x[i], vy = p.velocity.y[i], vz = p.velocity.z[i];
-      kinetic += 0.5 * double(p.mass[i]) * (vx * vx + vy * vy + vz * vz);
-    }
+    const std::size_t block_size = sim_->settings().block_size;
+    const double kinetic = sim::mechanics(p, block_size).kinetic;
     double potential = 0;
-    for (const auto& s : sim_->solvers()) potential += s->potential_energy(p, sim_->settings().block_size);
+    for (const auto& s : sim_->solvers()) potential += s->potential_energy(p, block_size);
+    std::string diagnostics;
+    for (const auto& [name, value] : sim::diagnostic_values(*sim_, p, block_size))
+      diagnostics += fmt::format("{}{}:{}", diagnostics.empty() ? "" : ",", json::string(name), json::number(value));
     return fmt::format(
-        R"({{"type":"status","mode":"live","step":{},"time":{},"steps_per_second":{},"paused":{},"at_end":{},"kinetic_energy":{},"potential_energy":{},"parameters":{},"surface":{}}})",
+        R"({{"type":"status","mode":"live","step":{},"time":{},"steps_per_second":{},"paused":{},"at_end":{},"kinetic_energy":{},"potential_energy":{},"diagnostics":{{{}}},"parameters":{},"surface":{}}})",
         sim_->step_count(), json::number(sim_->time()), json::number(rate), paused_ ? "true" : "false",
-        at_end_ ? "true" : "false", json::number(kinetic), json::number(potential), parameter_values_json(parameters_),
-        mesher_json(mesher_.get()));
+        at_end_ ? "true" : "false", json::number(kinetic), json::number(potential), diagnostics,
+        parameter_values_json(parameters_), mesher_json(mesher_.get()));
   }
 
   // Copies the state for the encoder when it is idle and a frame is due (or forced).

@@ -79,7 +79,7 @@ const check = (ok, what) => { log(ok ? "ok  " : "FAIL", what); if (!ok) failures
 // much; a higher viscosity calms its sloshing (it starts as a lattice).
 const pool = ["--set", "box.max=[0.6, 0.5, 0.6]", "--set", "particles.0.max=[0.6, 0.5, 0.2]",
   "--set", "particles.0.spacing=0.025", "--set", "particles.0.jitter=0.0", "--set", "sph.viscosity=2.0"];
-const swirl = spawn(swirlPath, ["view", scenePath, "--port", "0", "--seconds", "120", "--threads", "2",
+const swirl = spawn(swirlPath, ["view", scenePath, "--open", "never", "--port", "0", "--seconds", "120", "--threads", "2",
   ...pool, "--set", "simulation.end_time=1000"], { stdio: ["ignore", "pipe", "pipe"] });
 let stdout = "", stderr = "";
 swirl.stdout.on("data", (d) => { stdout += d; });
@@ -124,6 +124,9 @@ async function main() {
   await waitFor(() => window.swirlView.received >= 5 && window.swirlView.frames >= 10 && window.swirlView.status, "frames");
   const hello = await view(() => window.swirlView.hello);
   check(hello && hello.particles === 3840, `hello: ${hello && hello.particles} particles`);
+  // The live plots have the run's diagnostics: energy and the fluid's density error (a fraction of ρ0).
+  const plotted = await view(() => window.swirlView.history[window.swirlView.history.length - 1]);
+  check(plotted && Number.isFinite(plotted.e) && plotted.err > 0 && plotted.err < 0.5, `plotted diagnostics: ${JSON.stringify(plotted)}`);
 
   // 2. Screenshot of the canvas with the panels hidden.
   // A screenshot of the canvas alone (panels hidden), decoded in the page:
@@ -316,7 +319,7 @@ async function replay() {
   const made = spawnSync(swirlPath, ["run", scenePath, "--out", runDir, "--overwrite", "--threads", "2",
     "--set", "particles.0.spacing=0.025", "--set", "simulation.end_time=0.2"], { encoding: "utf8" });
   if (!check(made.status === 0, `swirl run writes a run folder (exit ${made.status})`)) throw new Error(made.stderr);
-  const viewer = replaying = spawn(swirlPath, ["view", runDir, "--port", "0", "--seconds", "60", "--paused"], { stdio: ["ignore", "pipe", "pipe"] });
+  const viewer = replaying = spawn(swirlPath, ["view", runDir, "--open", "never", "--port", "0", "--seconds", "60", "--paused"], { stdio: ["ignore", "pipe", "pipe"] });
   let out = "", err = "";
   viewer.stdout.on("data", (d) => { out += d; });
   viewer.stderr.on("data", (d) => { err += d; });

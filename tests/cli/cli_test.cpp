@@ -8,6 +8,8 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <chrono>
 
 #include "cli_support.hpp"
 #include "swirl/io/pvd.hpp"
@@ -171,6 +173,54 @@ TEST_F(Cli, InfoNamesTheBuild) {
   ASSERT_EQ(r.status, 0);
   for (const char* key : {"git revision", "build type", "compiler", "threads", "vector width"})
     EXPECT_NE(r.out.find(key), std::string::npos) << key;
+}
+
+// swirl view opens its page in the user's browser when one is at hand: with a
+// display (DISPLAY) by default, with --open always also without one, never
+// with --open never or over a bare terminal (SSH: the URL is printed). The
+// browser here is a script, named by $BROWSER, that notes the URL it is given.
+TEST_F(Cli, ViewOpensThePageInTheUsersBrowserWhenOneIsAtHand) {
+  const auto scene = write_scene("small.toml", kSmallScene);
+  const auto opened = dir_ / "opened.txt", browser = dir_ / "browser.sh";
+  std::ofstream(browser) << "#!/bin/sh\necho \"$1\" >> " << opened.string() << "\n";
+  fs::permissions(browser, fs::perms::owner_all);
+  const auto lines_opened = [&] {
+    const std::string text = fs::exists(opened) ? slurp(opened) : std::string();
+    return std::count(text.begin(), text.end(), '\n');
+  };
+  // The script runs on after swirl has moved on: wait for its line.
+  const auto wait_for_lines = [&](long n) {
+    for (int k = 0; k < 200 && lines_opened() < n; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    return lines_opened();
+  };
+  const std::string view = "view " + scene.string() + " --port 0 --paused --seconds 0.3";
+  const std::string with_display = "env -u WAYLAND_DISPLAY DISPLAY=:77 BROWSER=" + browser.string() + " ";
+  const std::string without = "env -u DISPLAY -u WAYLAND_DISPLAY BROWSER=" + browser.string() + " ";
+
+  auto r = swirl(view, with_display);
+  ASSERT_EQ(r.status, 0) << r.out << r.err;
+  ASSERT_EQ(wait_for_lines(1), 1) << r.out;
+  const std::string url = slurp(opened).substr(0, slurp(opened).find('\n'));
+  EXPECT_EQ(url.rfind("http://127.0.0.1:", 0), 0u) << url;
+  EXPECT_NE(r.out.find("live at " + url), std::string::npos) << "the page opened is the one printed: " << r.out;
+  EXPECT_NE(r.out.find("swirl view: opened in " + browser.string()), std::string::npos) << r.out;
+
+  r = swirl(view, without);  // a terminal without a display: the URL only
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.find("opened in"), std::string::npos) << r.out;
+  r = swirl(view + " --open never", with_display);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out.find("opened in"), std::string::npos) << r.out;
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(lines_opened(), 1);
+
+  // --open always without a display, and $BROWSER's "%s" standing for the URL.
+  r = swirl(view + " --open always", "env -u DISPLAY -u WAYLAND_DISPLAY BROWSER='" + browser.string() + " --at=%s' ");
+  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(wait_for_lines(2), 2);
+  const std::string second = slurp(opened).substr(url.size() + 1);
+  EXPECT_EQ(second.rfind("--at=http://127.0.0.1:", 0), 0u) << second;
+  EXPECT_EQ(swirl(view + " --open sometimes").status, 2) << "not one of auto, always, never";
 }
 
 TEST_F(Cli, UsageErrorsExitNonZero) {

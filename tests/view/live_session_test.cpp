@@ -27,6 +27,7 @@
 #include "swirl/scene/load.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/view/live_run.hpp"
+#include "swirl/sim/mechanics.hpp"
 #include "swirl/view/push_force.hpp"
 #include "view/ws_client.hpp"
 
@@ -120,6 +121,40 @@ TEST_F(LiveSession, PauseStepAndResumeActBetweenSteps) {
   std::uint64_t s = s0 + 1;
   for (int k = 0; k < 5 && s <= s0 + 1; ++k) s = field_u64(v.status(), "step");
   EXPECT_GT(s, s0 + 1);
+}
+
+// The statuses carry the numbers of the run's diagnostics.csv, for the
+// page's plots: at step 0 (paused) they equal those of the same scene built
+// and started here (sim/mechanics.hpp: the fluid's kinetic energy, the SPH
+// solver's mean and largest density error), to the 9 digits of the message.
+TEST_F(LiveSession, StatusesCarryTheRunsDiagnostics) {
+  start(/*paused=*/true);
+  Viewer v(port_);
+  const std::string st = v.status();
+  ASSERT_EQ(field_u64(st, "step"), 0u) << st;
+  ASSERT_EQ(scene_.precision, scene::Precision::Float);
+  auto sim = sim::build_simulation<float>(scene_);
+  sim.start();
+  const auto expected = sim::diagnostic_values(sim, sim.particles(), sim.settings().block_size);
+  const auto at = st.find("\"diagnostics\":{");
+  ASSERT_NE(at, std::string::npos) << st;
+  const std::string diagnostics = st.substr(at, st.find('}', at) - at);
+  std::size_t seen = 0;
+  for (const auto& [name, value] : expected) {
+    if (name != "mean_density_error" && name != "max_density_error") continue;
+    ++seen;
+    ASSERT_NE(diagnostics.find("\"" + name + "\":"), std::string::npos) << diagnostics;
+    EXPECT_NEAR(test::json_number_at(diagnostics, name), value, 1e-8 * value) << name;
+    EXPECT_GT(value, 0.0) << name;  // a lattice column is not at ρ0 everywhere
+  }
+  EXPECT_EQ(seen, 2u);
+  EXPECT_EQ(test::json_number_at(st, "kinetic_energy"), sim::mechanics(sim.particles(), sim.settings().block_size).kinetic);  // at rest: 0
+  // After single steps the column falls: the kinetic energy grows.
+  for (int k = 0; k < 5; ++k) v.send(encode_control(control::Step{}));
+  std::string later = v.status();
+  for (int k = 0; k < 20 && field_u64(later, "step") < 5; ++k) later = v.status();
+  ASSERT_EQ(field_u64(later, "step"), 5u) << later;
+  EXPECT_GT(test::json_number_at(later, "kinetic_energy"), 0.0) << later;
 }
 
 TEST_F(LiveSession, HostileMessagesAreDroppedAndTheRunAndOtherViewersGoOn) {
