@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/frame_names.hpp"
 #include "swirl/io/read_file.hpp"
@@ -35,6 +37,29 @@ double quantile(std::vector<double> values, double q) {
   const auto k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5);
   std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
   return values[k];
+}
+
+// The fluid's particles of a frame (all of them in a frame without kinds):
+// what the colour range and the splats' size are taken from, so that the
+// boundary particles' volume weights and pressures do not set them.
+Frame fluid_part(const Frame& f) {
+  if (f.kind.empty()) return f;
+  Frame out;
+  out.file = f.file, out.time = f.time;
+  const auto keep = [&f](const auto& from, auto& to) {
+    if (from.size() != f.kind.size()) return;  // a field the file does not have
+    for (std::size_t i = 0; i < from.size(); ++i)
+      if (!is_boundary(f.kind[i])) to.push_back(from[i]);
+  };
+  keep(f.positions, out.positions), keep(f.velocity, out.velocity), keep(f.mass, out.mass);
+  keep(f.density, out.density), keep(f.pressure, out.pressure);
+  return out;
+}
+
+// True strictly inside the box: the box walls' boundary particles lie a layer
+// outside its faces (scene::wall_offset), an obstacle's inside.
+bool strictly_inside(const Box<double>& box, const Vec3d& p) {
+  return p.x > box.lo.x && p.x < box.hi.x && p.y > box.lo.y && p.y < box.hi.y && p.z > box.lo.z && p.z < box.hi.z;
 }
 
 // Bounds of most particles (0.5 %–99.5 % per axis), padded by 10 %.
@@ -170,7 +195,7 @@ Frame first_frame(const RunInfo& run) {
 
 RunRenderer::RunRenderer(RunInfo run, RenderOptions options) : RunRenderer(first_frame(run), run, options) {}
 
-RunRenderer::RunRenderer(const Frame& first, RunInfo run, RenderOptions options)
+RunRenderer::RunRenderer(const Frame& whole_first, RunInfo run, RenderOptions options)
     : run_(std::move(run)), options_(options) {
   if (options_.width < 64 || options_.height < 64 || options_.width > 16384 || options_.height > 16384)
     throw std::invalid_argument(fmt::format("picture size {}x{}: each side must be between 64 and 16384 pixels",
@@ -183,7 +208,10 @@ RunRenderer::RunRenderer(const Frame& first, RunInfo run, RenderOptions options)
     throw std::invalid_argument("--surface draws a fluid's surface, and this is a gravity run with no [sph] fluid; "
                                 "draw it without --surface");
   if (options_.surface) log_density_ = false;
-  if (first.positions.empty()) throw io::IoError(first.file.string() + ": the frame has no particles");
+  if (whole_first.positions.empty()) throw io::IoError(whole_first.file.string() + ": the frame has no particles");
+  // A run that starts without fluid (a tap filling an empty tank) takes its scales from the whole frame.
+  const Frame fluid = fluid_part(whole_first);
+  const Frame& first = fluid.positions.empty() ? whole_first : fluid;
 
   const int bar_area = std::min(std::max(190, options_.width / 6), options_.width / 3);
   plot_width_ = options_.width - bar_area;
@@ -261,8 +289,23 @@ Image RunRenderer::render(const Frame& frame) const {
     style.lo = range_.first;
     style.hi = range_.second;
     style.radius = splat_radius_;
-    const std::vector<double> values = quantity_values(frame, quantity_);
-    draw_splats(image, camera_, frame.positions, values, style);
+    std::vector<double> values = quantity_values(frame, quantity_);
+    if (frame.kind.empty()) {
+      draw_splats(image, camera_, frame.positions, values, style);
+    } else {
+      // Boundary particles: the box walls' are left to the box's edges (drawn,
+      // they would hide the fluid behind the near wall); an obstacle's are
+      // drawn as a solid, in one grey (a NaN value, SplatStyle::solid).
+      std::vector<Vec3d> shown;
+      std::vector<double> shown_values;
+      for (std::size_t i = 0; i < frame.positions.size(); ++i) {
+        const bool boundary = is_boundary(frame.kind[i]);
+        if (boundary && run_.box && !strictly_inside(*run_.box, frame.positions[i])) continue;
+        shown.push_back(frame.positions[i]);
+        shown_values.push_back(boundary ? std::numeric_limits<double>::quiet_NaN() : values[i]);
+      }
+      draw_splats(image, camera_, shown, shown_values, style);
+    }
   }
 
   // The colour bar on a plain panel at the right, top = high.
@@ -299,7 +342,10 @@ Image RunRenderer::render(const Frame& frame) const {
   const int time_px = std::max(12, H / 24);
   const std::string time = run_.nbody ? fmt::format("t = {:.2f}", frame.time) : fmt::format("t = {:.3f} s", frame.time);
   font_.draw(image, time, time_px / 2, time_px + time_px / 3, time_px, kText);
-  const std::string caption = fmt::format("{} · {} particles", run_.scene_name, frame.positions.size());
+  const auto boundary = static_cast<std::size_t>(std::count_if(frame.kind.begin(), frame.kind.end(), is_boundary));
+  const std::string caption =
+      boundary ? fmt::format("{} · {} particles + {} boundary", run_.scene_name, frame.positions.size() - boundary, boundary)
+               : fmt::format("{} · {} particles", run_.scene_name, frame.positions.size());
   font_.draw(image, caption, time_px / 2, time_px * 2 + tick_px / 2 + 2, tick_px, Color{0.7f, 0.7f, 0.72f});
   return image;
 }

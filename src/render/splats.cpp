@@ -39,7 +39,7 @@ std::vector<Splat> prepare(const Image& image, const Camera& camera, std::span<c
       s.y = p->y;
       s.depth = p->depth;
       s.radius = std::max(style.radius * p->pixels_per_unit, style.min_radius_px);
-      s.color = colormap(style.map, span > 0 ? (values[i] - style.lo) / span : 0.0);
+      s.color = std::isnan(values[i]) ? style.solid : colormap(style.map, span > 0 ? (values[i] - style.lo) / span : 0.0);
       if (!(std::isfinite(s.x) && std::isfinite(s.y) && std::isfinite(s.radius))) continue;
       const double fx0 = std::floor(s.x - s.radius), fx1 = std::ceil(s.x + s.radius);
       const double fy0 = std::floor(s.y - s.radius), fy1 = std::ceil(s.y + s.radius);

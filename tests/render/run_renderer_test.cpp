@@ -188,6 +188,59 @@ TEST(RunRenderer, DrawsTheParticlesTheTimeAndTheColourBar) {
   EXPECT_TRUE(top && bottom);
 }
 
+// Boundary particles: the box walls' layer (outside the faces) is not drawn,
+// so the fluid behind the near wall shows (the picture, below the caption,
+// is the one of the frame without the walls); an obstacle's particles inside
+// the box are drawn as a solid, grey, whatever the colour field; the colour
+// range and the splats' size come from the fluid alone.
+TEST(RunRenderer, WallsAreLeftOutAndObstaclesDrawnAsSolids) {
+  RunInfo run;
+  run.box = Box<double>{{0, 0, 0}, {1, 1, 1}};
+  run.rest_density = 1000;
+  Frame fluid_and_obstacle;
+  const auto add = [](Frame& f, Vec3d x, double speed, std::int32_t kind, double mass) {
+    f.positions.push_back(x);
+    f.velocity.push_back({speed, 0, 0});
+    f.mass.push_back(mass);
+    f.density.push_back(1000);
+    f.pressure.push_back(kind ? 5e4 : 100 * x.z);
+    f.kind.push_back(kind);
+  };
+  for (double x = 0.1; x < 0.45; x += 0.04)
+    for (double y = 0.3; y < 0.7; y += 0.04)
+      for (double z = 0.02; z < 0.4; z += 0.04) add(fluid_and_obstacle, {x, y, z}, 0.5 + x, 0, 0.064);
+  for (double x = 0.6; x < 0.9; x += 0.04)
+    for (double y = 0.4; y < 0.6; y += 0.04)
+      for (double z = 0.02; z < 0.3; z += 0.04) add(fluid_and_obstacle, {x, y, z}, 0, 1, 0.01);
+  Frame walled = fluid_and_obstacle;
+  for (double x = 0; x <= 1; x += 0.04)  // the two y faces' layers, just outside
+    for (double z = 0; z <= 1; z += 0.04)
+      for (const double y : {-0.02, 1.02}) add(walled, {x, y, z}, 0, 1, 0.01);
+
+  RenderOptions o = small();
+  o.view = View::Front;
+  const RunRenderer renderer(walled, run, o), without_walls(fluid_and_obstacle, run, o);
+  EXPECT_EQ(renderer.range(), without_walls.range()) << "the range is the fluid's";
+  const Image a = renderer.render(walled), b = without_walls.render(fluid_and_obstacle);
+  std::size_t differ = 0;
+  for (int y = a.height() / 5; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x) differ += a.at(x, y) != b.at(x, y);
+  EXPECT_EQ(differ, 0u) << "the walls' particles were drawn";
+  // Around the obstacle's middle every pixel is grey; around the fluid's none.
+  const auto greys_around = [&](Vec3d at) {
+    const auto c = renderer.camera().project(at);
+    int n = 0;
+    for (int y = int(c->y) - 2; y <= int(c->y) + 2; ++y)
+      for (int x = int(c->x) - 2; x <= int(c->x) + 2; ++x) {
+        const Color p = a.at(x, y);
+        n += std::abs(p.r - p.g) < 0.02f && p.b >= p.g && p.b - p.g < 0.1f && p.r > 0.3f;
+      }
+    return n;
+  };
+  EXPECT_GE(greys_around({0.74, 0.5, 0.14}), 20) << "the obstacle is drawn as a grey solid (gaps between discs aside)";
+  EXPECT_EQ(greys_around({0.26, 0.5, 0.2}), 0) << "the fluid is coloured by its speed";
+}
+
 TEST(RunRenderer, RenderEveryDrawsOnlyEveryKthFrame) {
   FakeRun run;
   const auto hook = render_every(run.dir.path, 2, small());

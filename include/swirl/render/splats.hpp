@@ -4,7 +4,7 @@
 // min_radius_px pixels) coloured by colormap((value − lo) / (hi − lo)); its
 // opacity is `opacity` in the middle and falls to 0 at the rim, and it is
 // shaded like a sphere (brighter in the middle) so overlapping particles read
-// as a surface. Discs are blended far to near; equal depths keep particle
+// as a surface. A NaN value is drawn in style.solid instead (not a fluid). Discs are blended far to near; equal depths keep particle
 // order, so the picture does not depend on anything but the input.
 //
 // Parallel and deterministic: the picture is cut into tiles of tile_size²
@@ -29,6 +29,7 @@ struct SplatStyle {
   double radius = 0.01;         // world units
   double min_radius_px = 0.75;  // so far or tiny particles still show
   float opacity = 0.9f;         // at the disc's centre, in [0, 1]
+  Color solid{0.62f, 0.62f, 0.66f};  // the colour of a NaN value: solids (obstacles' boundary particles)
   int tile_size = 32;           // pixels; any value ≥ 1 gives the same picture
 };
 
