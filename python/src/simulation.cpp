@@ -31,7 +31,9 @@
 #include <nanobind/stl/unique_ptr.h>
 
 #include "bindings.hpp"
+#include "swirl/core/particle_kind.hpp"
 #include "swirl/io/csv.hpp"
+#include "swirl/io/frame_names.hpp"
 #include "swirl/io/vtp.hpp"
 #include "swirl/scene/validate.hpp"
 #include "swirl/sim/inlets_outlets.hpp"
@@ -114,7 +116,8 @@ class AnySimulation {
   virtual const render::RunInfo& run_info() const = 0;
   virtual nb::dict metrics() = 0;
   virtual nb::dict phases() = 0;
-  virtual void write_frame(const std::string& path, const std::string& format) = 0;
+  // The files written: the frame, then its boundary particles' file when the set has any.
+  virtual std::vector<std::string> write_frame(const std::string& path, const std::string& format) = 0;
 };
 
 template <class Real>
@@ -270,11 +273,26 @@ class TypedSimulation final : public AnySimulation {
   }
   const render::RunInfo& run_info() const override { return run_info_; }
 
-  // One frame file as the run's frame writer writes it (the same io:: writer).
-  void write_frame(const std::string& path, const std::string& format) override {
-    if (format == "vtp") io::write_vtp(path, live().particles(), live().time());
-    else if (format == "csv") io::write_csv(path, live().particles(), live().time());
-    else throw nb::value_error(fmt::format("format '{}': give \"vtp\" or \"csv\"", format).c_str());
+  // The frame as the run's frame writer writes it (the same io:: writers, and
+  // the same split: boundary particles in a file of their own beside it,
+  // io::boundary_file_beside, which swirl render and the replay pair with it).
+  std::vector<std::string> write_frame(const std::string& path, const std::string& format) override {
+    if (format != "vtp" && format != "csv")
+      throw nb::value_error(fmt::format("format '{}': give \"vtp\" or \"csv\"", format).c_str());
+    const auto write = [&](const std::string& file, const ParticleSet<Real>& set) {
+      if (format == "vtp") io::write_vtp(file, set, live().time());
+      else io::write_csv(file, set, live().time());
+    };
+    const ParticleSet<Real>& p = live().particles();
+    const KindSplit split = split_by_kind(p);
+    if (split.boundary.empty()) {
+      write(path, p);
+      return {path};
+    }
+    const std::string boundary = io::boundary_file_beside(path).string();
+    write(path, p.subset(split.rest));
+    write(boundary, p.subset(split.boundary));
+    return {path, boundary};
   }
 
  private:
@@ -577,7 +595,7 @@ void bind_simulation(nb::module_& m) {
       .def("phases", [](PySimulation& s) { return s.sim().phases(); })
       .def("write_frame", [](PySimulation& s, const std::string& path, const std::string& format) {
         nb::gil_scoped_release release;
-        s.sim().write_frame(path, format);
+        return s.sim().write_frame(path, format);
       });
 }
 

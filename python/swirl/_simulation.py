@@ -2,6 +2,7 @@
 
 import numbers
 import os
+import pathlib
 import weakref
 
 import numpy as np
@@ -312,15 +313,18 @@ class Simulation:
         return self._native.phases()
 
     def write_frame(self, path, format=None):
-        """Writes the current state as one frame file, with the writer ``swirl run`` uses.
+        """Writes the current state as a frame, with the writer ``swirl run`` uses; returns the paths written.
 
         ``format``: ``"vtp"`` (ParaView) or ``"csv"``; default from the path's suffix.
-        Fields in storage order, with their ids.
+        Fields in storage order, with their ids. As in a run, boundary particles
+        (walls and obstacles of particles) go to a file of their own beside it:
+        ``boundary_NNNNNN.vtp`` for ``particles_NNNNNN.vtp`` (``swirl render`` reads
+        the two together), else ``<stem>_boundary.vtp``.
         """
         path = os.fspath(path)
         if format is None:
             format = os.path.splitext(path)[1].lstrip(".").lower()
-        self._native.write_frame(path, format)
+        return [pathlib.Path(p) for p in self._native.write_frame(path, format)]
 
     def render(self, *, view="front", color=None, size=(1280, 720), range=None, projection=None, png=None):
         """Draws the current state as ``swirl render`` draws a frame; returns an (height, width, 3) uint8 RGB image.

@@ -46,6 +46,28 @@ def test_frames_byte_identical_to_the_cli(swirl, tmp_path):
     assert filecmp.cmp(cli / "particles_000002.vtp", tmp_path / "step20.vtp", shallow=False)
 
 
+def test_write_frame_splits_boundary_particles_as_the_run_does(swirl, tmp_path):
+    # Walls of boundary particles: a run writes them to their own series (boundary_000000.vtp, once: they do
+    # not move); write_frame likewise writes them beside the frame, byte-identical to the CLI's files.
+    walls = 'box.walls="particles"'
+    cli = cli_run(tmp_path, "--steps", str(STEPS), "--set", walls)
+    scene = swirl.Scene.from_file(EXAMPLES / "dam_break.toml", overrides=SPH_OVERRIDES + [walls])
+    sim = swirl.Simulation(scene)
+    boundary = int((sim.particles.kind.copy() != 0).sum())
+    assert 0 < boundary < sim.count
+    written = sim.write_frame(tmp_path / "particles_000000.vtp")
+    assert [p.name for p in written] == ["particles_000000.vtp", "boundary_000000.vtp"]
+    assert filecmp.cmp(cli / "particles_000000.vtp", written[0], shallow=False)
+    assert filecmp.cmp(cli / "boundary_000000.vtp", written[1], shallow=False)
+    sim.run(steps=STEPS)
+    written = sim.write_frame(tmp_path / "end.csv")
+    assert [p.name for p in written] == ["end.csv", "end_boundary.csv"]
+    rows = [sum(1 for line in open(p) if line[:1].isdigit()) for p in written]
+    assert rows == [sim.count - boundary, boundary]
+    sim.write_frame(tmp_path / "end.vtp")
+    assert filecmp.cmp(cli / "particles_000002.vtp", tmp_path / "end.vtp", shallow=False)
+
+
 def test_summary_and_diagnostics(swirl, sph_scene, tmp_path):
     out = tmp_path / "run"
     summary = swirl.run(sph_scene, out, steps=10, threads=1)

@@ -52,4 +52,11 @@ std::optional<fs::path> boundary_frame_for(const fs::path& particles_frame) {
   return best;
 }
 
+fs::path boundary_file_beside(const fs::path& frame) {
+  const std::string extension = frame.extension().string();
+  if (const auto n = frame_index(frame, kParticleSeries))
+    return frame.parent_path() / frame_file_name(kBoundarySeries, *n, extension);
+  return frame.parent_path() / (frame.stem().string() + "_boundary" + extension);
+}
+
 }  // namespace swirl::io

@@ -135,19 +135,14 @@ class FrameWriter final : public Observer<Real> {
       return;
     }
     std::filesystem::path first;
-    const std::size_t kind_field = whole.find_int_field(kKindField);
-    std::vector<std::size_t> rest, walls;  // particle indices of the two series
-    if (kind_field != ParticleSet<Real>::npos) {
-      const auto& kind = whole.int_field(kind_field);
-      for (std::size_t i = 0; i < whole.size(); ++i) (is_boundary(kind[i]) ? walls : rest).push_back(i);
-    }
-    if (walls.empty()) {
+    const KindSplit split = split_by_kind(whole);  // particle indices of the two series
+    if (split.boundary.empty()) {
       first = write_frame(particles_, whole, sim.time());
     } else {
-      first = write_frame(particles_, whole.subset(rest), sim.time());
+      first = write_frame(particles_, whole.subset(split.rest), sim.time());
       const auto* moving = sim.moving_boundaries();
       if (boundary_.written == 0 || (moving && !moving->empty()))
-        write_frame(boundary_, whole.subset(walls), sim.time());
+        write_frame(boundary_, whole.subset(split.boundary), sim.time());
     }
     ++frames_;
     last_step_ = sim.step_count();

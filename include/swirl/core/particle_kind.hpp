@@ -18,7 +18,9 @@
 //    mass and leaves it out of the fluid's diagnostics and solves.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 #include <string_view>
 
 namespace swirl {
@@ -31,5 +33,22 @@ enum class ParticleKind : std::int32_t { Fluid = 0, Boundary = 1 };
 
 // True when a particle of kind value k is a (static) boundary particle.
 constexpr bool is_boundary(std::int32_t k) { return k != static_cast<std::int32_t>(ParticleKind::Fluid); }
+
+// The storage indices of a set's boundary particles and of the rest (fluid, or
+// stars), each in storage order: the two frame series. Both are empty for a
+// set without the kind field (then all of it is "the rest"). `Set` is a
+// ParticleSet<Real> (find_int_field, int_field, npos).
+struct KindSplit {
+  std::vector<std::size_t> rest, boundary;
+};
+template <class Set>
+KindSplit split_by_kind(const Set& p) {
+  KindSplit out;
+  const std::size_t field = p.find_int_field(kKindField);
+  if (field == Set::npos) return out;
+  const auto& kind = p.int_field(field);
+  for (std::size_t i = 0; i < p.size(); ++i) (is_boundary(kind[i]) ? out.boundary : out.rest).push_back(i);
+  return out;
+}
 
 }  // namespace swirl

@@ -38,4 +38,10 @@ std::optional<int> frame_part_type(const std::filesystem::path& frame);
 // when there is none or `particles_frame` is not named as a particle frame.
 std::optional<std::filesystem::path> boundary_frame_for(const std::filesystem::path& particles_frame);
 
+// Where one frame's boundary particles go when a caller writes a single frame
+// (Python's write_frame): boundary_NNNNNN<ext> beside particles_NNNNNN<ext>,
+// so that boundary_frame_for() pairs them as in a run; for any other name,
+// <stem>_boundary<ext> beside it.
+std::filesystem::path boundary_file_beside(const std::filesystem::path& frame);
+
 }  // namespace swirl::io
