@@ -115,4 +115,28 @@ TYPED_TEST(ReorderParticlesTest, TheInverseOrderRestoresTheOriginal) {
   expect_bit_identical(p, original, "inverse");
 }
 
+// select(): a gather to fewer (or as many) particles, against the slow twin
+// ParticleSet::subset, with more fields than one group (the scratch, swapped
+// out by each group, must take the new size every time), and again after a
+// same-size reorder with the same object (scratch of another size).
+TYPED_TEST(ReorderParticlesTest, SelectMatchesSubsetAndShrinksEveryField) {
+  using Real = TypeParam;
+  const std::size_t n = 3001;
+  const auto original = random_set<Real>(n, 5, 9, 21);
+  spatial::ParticleReorder<Real> reorder;
+  for (const std::size_t keep : {std::size_t{2000}, n, std::size_t{1}, std::size_t{0}}) {
+    auto picked = random_order(n, 31 + keep);
+    picked.resize(keep);
+    auto fast = original;
+    reorder.apply(fast, random_order(n, 5), 256);  // scratch of the full size first
+    auto slow = fast.subset(std::vector<std::size_t>(picked.begin(), picked.end()));
+    reorder.select(fast, picked, 256);
+    ASSERT_EQ(fast.size(), keep);
+    fast.for_each_array([&](const AlignedVector<Real>& a) { EXPECT_EQ(a.size(), keep); });
+    fast.for_each_int_array([&](const AlignedVector<std::int32_t>& a) { EXPECT_EQ(a.size(), keep); });
+    EXPECT_EQ(fast.id.size(), keep);
+    expect_bit_identical(fast, slow, "select " + std::to_string(keep));
+  }
+}
+
 }  // namespace

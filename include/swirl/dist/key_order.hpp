@@ -49,13 +49,31 @@ struct Distribution {
   std::size_t sent_away = 0;
 };
 
+// What distribute_in_key_order() keeps between calls (its sort's and its
+// reorder's buffers, so that a step does not allocate and fault them in anew).
+template <class Real>
+struct DistributeWorkspace {
+  parallel::RadixSort<std::uint64_t> sorter;
+  spatial::ParticleReorder<Real> reorder;
+  std::vector<int> destination;              // per own particle: its rank
+  std::vector<std::uint32_t> source, picked;  // the new order's particles, before and after the sort
+  std::vector<std::uint64_t> unsorted;        // their keys before the sort
+};
+
 // particles[i] has key keys[i] and global index first_global_index + i (the
 // previous order). On return particles and keys hold this rank's range of the
 // new global order. Collective: every rank calls it with the same cut_keys.
+//
+// Only the particles that leave are packed into records and sent; those that
+// stay do not move until the one gather that sorts. The new order before the
+// sort is the arrivals from lower ranks, the staying particles, the arrivals
+// from higher ranks: the previous global order (each source held a contiguous
+// range of it and sent in that order), so the stable sort by key (the one-rank
+// radix sort, parallel and linear) is the sort by (key, previous global index).
 template <class Real>
 Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>& particles,
                                      std::vector<std::uint64_t>& keys, std::uint64_t first_global_index,
-                                     std::span<const std::uint64_t> cut_keys) {
+                                     std::span<const std::uint64_t> cut_keys, DistributeWorkspace<Real>& work) {
   using Int = typename ParticleSet<Real>::int_type;
   const std::size_t n = particles.size();
   if (keys.size() != n) throw std::invalid_argument("distribute_in_key_order: one key per particle is needed");
@@ -71,22 +89,27 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
   const std::size_t record = 3 * sizeof(std::uint64_t) + real_arrays * sizeof(Real) + int_arrays * sizeof(Int);
 
   const auto ranks = static_cast<std::size_t>(comm.size());
-  std::vector<Bytes> send(ranks);
-  std::vector<int> destination(n);
+  const auto me = comm.rank();
+  std::vector<int>& destination = work.destination;
+  destination.resize(n);
   std::vector<std::size_t> per_rank(ranks, 0);
   for (std::size_t i = 0; i < n; ++i) {
     destination[i] = owner_of(keys[i], cut_keys);
     ++per_rank[static_cast<std::size_t>(destination[i])];
   }
-  std::vector<std::size_t> filled(ranks, 0);
-  for (std::size_t d = 0; d < ranks; ++d) send[d].resize(per_rank[d] * record);
+  const std::size_t staying = per_rank[static_cast<std::size_t>(me)];
+  std::vector<Bytes> send(ranks);
+  for (std::size_t d = 0; d < ranks; ++d)
+    if (d != static_cast<std::size_t>(me)) send[d].resize(per_rank[d] * record);
   auto put = [](std::byte*& at, const auto& value) {
     std::memcpy(at, &value, sizeof(value));
     at += sizeof(value);
   };
+  std::vector<std::size_t> filled(ranks, 0);
   for (std::size_t i = 0; i < n; ++i) {
-    const auto d = static_cast<std::size_t>(destination[i]);
-    std::byte* at = send[d].data() + filled[d]++ * record;
+    const int d = destination[i];
+    if (d == me) continue;
+    std::byte* at = send[static_cast<std::size_t>(d)].data() + filled[static_cast<std::size_t>(d)]++ * record;
     put(at, keys[i]);
     put(at, std::uint64_t{first_global_index + i});
     put(at, particles.id[i]);
@@ -94,51 +117,80 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
     particles.for_each_int_array([&](const AlignedVector<Int>& a) { put(at, a[i]); });
   }
   Distribution result;
-  result.sent_away = n - per_rank[static_cast<std::size_t>(comm.rank())];
+  result.sent_away = n - staying;
 
   const std::vector<Bytes> received = comm.all_to_all(send);
   send.clear();
-  std::size_t count = 0;
-  for (const Bytes& b : received) {
-    if (b.size() % record != 0) throw std::runtime_error("distribute_in_key_order: a rank sent a partial record");
-    count += b.size() / record;
+  std::size_t lower = 0, arrivals = 0;
+  for (std::size_t r = 0; r < ranks; ++r) {
+    if (received[r].size() % record != 0) throw std::runtime_error("distribute_in_key_order: a rank sent a partial record");
+    arrivals += received[r].size() / record;
+    if (r < static_cast<std::size_t>(me)) lower += received[r].size() / record;
   }
-  // Unpack in arrival order (source rank order). Each source rank held a
-  // contiguous range of the previous order and sent its particles in that
-  // order, and the sources arrive in rank order: so the arrival order is the
-  // previous global order (checked as the records come), and the stable sort
-  // by key (the one-rank radix sort, parallel and linear) is the sort by
-  // (key, previous global index).
-  if (count > 0xffffffffu) throw std::invalid_argument("distribute_in_key_order: more than 2^32 - 1 particles on a rank");
-  particles.resize(count);
-  keys.resize(count);
+  const std::size_t count = staying + arrivals;
+  if (n + arrivals > 0xffffffffu) throw std::invalid_argument("distribute_in_key_order: more than 2^32 - 1 particles on a rank");
+  // The arrivals are unpacked behind the particles already here (indices n …),
+  // and nothing else moves until the one gather at the end.
+  particles.resize(n + arrivals);
+  keys.resize(n + arrivals);
   auto get = [](const std::byte*& at, auto& value) {
     std::memcpy(&value, at, sizeof(value));
     at += sizeof(value);
   };
-  std::size_t j = 0;
+  // The new order before the sort, as indices into that layout: the lower
+  // ranks' arrivals, the staying particles, the higher ranks' arrivals. The
+  // arrivals' previous global indices are checked to be in that order (below
+  // this rank's range from lower ranks, above it from higher ones; an empty
+  // rank's range has no place to check against).
+  std::vector<std::uint32_t>& source = work.source;
+  std::vector<std::uint64_t>& unsorted = work.unsorted;
+  source.resize(count);
+  unsorted.resize(count);
+  std::size_t next = n;  // where the next arrival is unpacked
+  std::size_t j = 0;     // its place in the new order before the sort
+  bool any = false;
   std::uint64_t previous = 0;
-  for (const Bytes& b : received) {
-    for (const std::byte* at = b.data(); at != b.data() + b.size(); ++j) {
+  for (std::size_t r = 0; r < ranks; ++r) {
+    if (r == static_cast<std::size_t>(me)) {
+      for (std::size_t i = 0; i < n; ++i)
+        if (destination[i] == me) source[j] = static_cast<std::uint32_t>(i), unsorted[j++] = keys[i];
+      if (n > 0) any = true, previous = first_global_index + n - 1;
+      continue;
+    }
+    const Bytes& b = received[r];
+    for (const std::byte* at = b.data(); at != b.data() + b.size(); ++next, ++j) {
       std::uint64_t index = 0;
-      get(at, keys[j]);
+      get(at, keys[next]);
       get(at, index);
-      if (j > 0 && index <= previous)
+      if ((any && index <= previous) || (r < static_cast<std::size_t>(me) && n > 0 && index >= first_global_index))
         throw std::logic_error("distribute_in_key_order: the ranks' particles were not in the global order");
-      previous = index;
-      get(at, particles.id[j]);
-      particles.for_each_array([&](AlignedVector<Real>& a) { get(at, a[j]); });
-      particles.for_each_int_array([&](AlignedVector<Int>& a) { get(at, a[j]); });
+      any = true, previous = index;
+      get(at, particles.id[next]);
+      particles.for_each_array([&](AlignedVector<Real>& a) { get(at, a[next]); });
+      particles.for_each_int_array([&](AlignedVector<Int>& a) { get(at, a[next]); });
+      source[j] = static_cast<std::uint32_t>(next), unsorted[j] = keys[next];
     }
   }
-  parallel::RadixSort<std::uint64_t> sorter;
-  sorter.sort(keys, 64);
-  spatial::ParticleReorder<Real>().apply(particles, sorter.order(), kReorderBlock);
-  keys.assign(sorter.keys().begin(), sorter.keys().end());
+  work.sorter.sort(unsorted, 64);
+  std::vector<std::uint32_t>& picked = work.picked;
+  picked.resize(count);
+  const auto order = work.sorter.order();
+  for (std::size_t k = 0; k < count; ++k) picked[k] = source[order[k]];
+  work.reorder.select(particles, picked, kReorderBlock);
+  keys.assign(work.sorter.keys().begin(), work.sorter.keys().end());
 
   result.first_global_index = comm.exclusive_prefix_sum(count);
   result.global_count = comm.sum(static_cast<std::uint64_t>(count));
   return result;
+}
+
+// The same with buffers of its own (a caller that sorts once).
+template <class Real>
+Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>& particles,
+                                     std::vector<std::uint64_t>& keys, std::uint64_t first_global_index,
+                                     std::span<const std::uint64_t> cut_keys) {
+  DistributeWorkspace<Real> work;
+  return distribute_in_key_order(comm, particles, keys, first_global_index, cut_keys, work);
 }
 
 }  // namespace swirl::dist

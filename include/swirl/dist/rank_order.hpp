@@ -175,7 +175,7 @@ class RankOrder {
     }
     if (cut_rule_) cut_keys_ = cut_rule_(keys_, std::move(cut_keys_));
     rank_costs_ = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
-    const Distribution d = distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_);
+    const Distribution d = distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_, distribute_work_);
     first_ = d.first_global_index;
     global_count_ = d.global_count;
     sent_away_ = d.sent_away;
@@ -205,7 +205,12 @@ class RankOrder {
   double imbalance() const { return rank_costs_.empty() ? 1.0 : dist::imbalance(rank_costs_); }
   std::size_t sent_away() const { return sent_away_; }
   std::size_t bytes() const {
-    return (keys_.capacity() + cut_keys_.capacity() + costs_.capacity() + rank_costs_.capacity()) * sizeof(std::uint64_t);
+    // The kept sort buffers as ParticleOrder counts its own: keys and order, twice.
+    return (keys_.capacity() + cut_keys_.capacity() + costs_.capacity() + rank_costs_.capacity()) * sizeof(std::uint64_t) +
+           distribute_work_.reorder.bytes() + distribute_work_.destination.capacity() * sizeof(int) +
+           (distribute_work_.source.capacity() + distribute_work_.picked.capacity()) * sizeof(std::uint32_t) +
+           distribute_work_.unsorted.capacity() * sizeof(std::uint64_t) +
+           keys_.size() * 2 * (sizeof(std::uint64_t) + sizeof(std::uint32_t));
   }
 
  private:
@@ -297,6 +302,7 @@ class RankOrder {
   std::size_t sent_away_ = 0;
   std::uint64_t epoch_ = 0;
   std::uint64_t sorts_ = 0;
+  DistributeWorkspace<Real> distribute_work_;  // the sort's buffers, kept between steps
 };
 
 }  // namespace swirl::dist

@@ -10,7 +10,8 @@
 // and a reorder costs ⌈max(real, integer fields)/4⌉ fork/joins: integer fields
 // ride along with the real ones' loops. The slow twin is ParticleSet::reorder.
 // Precondition (not checked, hot path): order is a permutation of 0..size()-1;
-// the sorts that make it (parallel::RadixSort) guarantee it.
+// the sorts that make it (parallel::RadixSort) guarantee it. select() gathers
+// a subset (the distributed sort's: the particles that stayed and arrived).
 #pragma once
 
 #include <algorithm>
@@ -33,15 +34,20 @@ class ParticleReorder {
   using Int = typename ParticleSet<Real>::int_type;
 
   void apply(ParticleSet<Real>& p, std::span<const std::uint32_t> order, std::size_t block_size) {
-    const std::size_t n = p.size();
-    if (order.size() != n) throw std::invalid_argument("reorder_particles: order has the wrong length");
+    if (order.size() != p.size()) throw std::invalid_argument("reorder_particles: order has the wrong length");
+    select(p, order, block_size);
+  }
+
+  // The same gather to a set of picked.size() particles: the particle at old
+  // index picked[i] ends at index i, the ones not picked are dropped (each
+  // index < size(), none twice: not checked). apply() is select() with a
+  // permutation.
+  void select(ParticleSet<Real>& p, std::span<const std::uint32_t> order, std::size_t block_size) {
+    const std::size_t n = order.size();
     std::vector<AlignedVector<Real>*> reals;
     p.for_each_array([&](AlignedVector<Real>& a) { reals.push_back(&a); });
     std::vector<AlignedVector<Int>*> ints;
     p.for_each_int_array([&](AlignedVector<Int>& a) { ints.push_back(&a); });
-    for (auto& s : scratch_) s.resize(n);
-    // Integer scratch only as far as used: a run without integer fields keeps none.
-    for (std::size_t k = 0; k < std::min(kGroup, ints.size()); ++k) int_scratch_[k].resize(n);
     ids_.resize(n);
     // kGroup fields of each kind per parallel loop (the ids with the first
     // group): one fork/join per group instead of one per field — the
@@ -52,6 +58,10 @@ class ParticleReorder {
       const std::size_t first = g * kGroup;
       const std::size_t real_count = count_in_group(reals.size(), first);
       const std::size_t int_count = count_in_group(ints.size(), first);
+      // Sized per group: the scratch holds the arrays the group before swapped out (of the old size, when
+      // select() shrinks). Integer scratch only as far as used: a run without integer fields keeps none.
+      for (std::size_t k = 0; k < real_count; ++k) scratch_[k].resize(n);
+      for (std::size_t k = 0; k < int_count; ++k) int_scratch_[k].resize(n);
       parallel::for_blocks_pinned("reorder", n, block_size, [&](std::size_t b, std::size_t e, std::size_t) {
         for (std::size_t k = 0; k < real_count; ++k) gather(reals[first + k]->data(), scratch_[k].data(), order, b, e);
         for (std::size_t k = 0; k < int_count; ++k) gather(ints[first + k]->data(), int_scratch_[k].data(), order, b, e);
