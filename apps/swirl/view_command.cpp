@@ -76,7 +76,7 @@ std::string open_in_browser(const std::string& url, const std::string& mode) {
   std::vector<std::string> argv;
   if (browser.empty()) argv = {opener, url};
   else if (const auto at = browser.find("%s"); at != std::string::npos)
-    argv = {"/bin/sh", "-c", browser.replace(at, 2, url)};  // the URL is ours: no quoting needed
+    argv = {"/bin/sh", "-c", std::string(browser).replace(at, 2, url)};  // the URL is ours: no quoting needed
   else argv = {browser, url};
   std::vector<char*> raw;
   for (auto& a : argv) raw.push_back(a.data());
@@ -93,7 +93,7 @@ std::string open_in_browser(const std::string& url, const std::string& mode) {
   if (failed) return fmt::format("could not start {} ({}): open the URL above yourself", argv[0], std::strerror(failed));
   // Reaped on its own thread: xdg-open returns once the browser has the URL; a browser itself may run on.
   std::thread([pid] { int status = 0; ::waitpid(pid, &status, 0); }).detach();
-  return fmt::format("opened in {}", browser.empty() ? opener : argv[0]);
+  return fmt::format("opened in {}", browser.empty() ? opener : browser);
 }
 
 std::string random_token() {

@@ -220,6 +220,7 @@ TEST_F(Cli, ViewOpensThePageInTheUsersBrowserWhenOneIsAtHand) {
   ASSERT_EQ(wait_for_lines(2), 2);
   const std::string second = slurp(opened).substr(url.size() + 1);
   EXPECT_EQ(second.rfind("--at=http://127.0.0.1:", 0), 0u) << second;
+  EXPECT_NE(r.out.find("swirl view: opened in " + browser.string() + " --at=%s"), std::string::npos) << r.out;
   EXPECT_EQ(swirl(view + " --open sometimes").status, 2) << "not one of auto, always, never";
 }
 
