@@ -275,6 +275,29 @@ TYPED_TEST(EssentialTreeTest, WithinTheOpeningErrorOfTheDirectSum) {
 // The export volume at a size of one's choosing (SWIRL_LET_PARTICLES, e.g.
 // 131072; skipped without it): a Plummer sphere with the default settings,
 // its field checked against the one-rank walk as above, the volume printed.
+// The import check (a replay of the rank's walks) runs on the first build
+// and then every k-th; the builds between give the same field.
+TEST(EssentialTreeCheck, TheImportIsCheckedOnTheFirstBuildAndEveryKth) {
+  const Communicator& comm = Communicator::world();
+  const Case c = cases().front();
+  const ParticleSet<double> all = model<double>(c.model);
+  Part<double> part = distribute(comm, all, c.settings);
+  EssentialTree<double> tree;
+  tree.set_check_every(3);
+  GravityField<double> first, field;
+  for (int b = 0; b < 5; ++b) {
+    tree.build(comm, part.p, part.keys, part.distribution.first_global_index, part.cuts, part.cube, c.settings, 64);
+    EXPECT_EQ(tree.stats().checked, b % 3 == 0) << "build " << b;
+    if (comm.size() > 1) {
+      EXPECT_EQ(tree.stats().nodes_used > 0, b % 3 == 0) << "build " << b;
+    }
+    tree.evaluate(b == 0 ? first : field);
+  }
+  ASSERT_EQ(field.size(), first.size());
+  for (int a = 0; a < 3; ++a)
+    EXPECT_EQ(std::memcmp(field.acceleration[a].data(), first.acceleration[a].data(), first.size() * sizeof(double)), 0);
+}
+
 TEST(EssentialTreeScale, ExchangeVolumeOfALargerPlummerSphere) {
   const char* size = std::getenv("SWIRL_LET_PARTICLES");
   if (size == nullptr) GTEST_SKIP() << "set SWIRL_LET_PARTICLES to measure";

@@ -112,6 +112,7 @@ TEST_P(DamBreakFront, FollowsMartinAndMoycesMeasurements) {
   EXPECT_LE(worst, 0.15) << GetParam() << ": the front is " << 100 * worst << " % off the measured one at T = " << worst_T;
 }
 
-INSTANTIATE_TEST_SUITE_P(BothMethods, DamBreakFront, ::testing::Values("dfsph", "wcsph"));
+INSTANTIATE_TEST_SUITE_P(BothMethods, DamBreakFront, ::testing::Values("dfsph", "wcsph"),
+                         [](const ::testing::TestParamInfo<const char*>& method) { return std::string(method.param); });
 
 }  // namespace

@@ -49,9 +49,10 @@
 //      every other rank sent (children contiguous, in child order; particles
 //      in global slot order, so every node's range nests as on one rank), and
 //      LinearOctree::assemble() runs the group walk over it unchanged for its
-//      own groups. Before that, build() replays its own groups' walks and
-//      throws std::logic_error if one would open a node whose children or
-//      particles are missing (it never should: the export is a superset).
+//      own groups. Before that, on its first call and every 64th
+//      (set_check_every), build() replays its own groups' walks and throws
+//      std::logic_error if one would open a node whose children or particles
+//      are missing (it never should: the export is a superset).
 //
 // Where bit-identity could break, and what holds it:
 //   - the key frame: a global exact min/max gives the one-rank cube;
@@ -114,7 +115,9 @@ struct EssentialTreeStats {
   // The locally essential tree proper (all-to-all), to and from the other ranks.
   std::uint64_t nodes_sent = 0, particles_sent = 0, bytes_sent = 0;
   std::uint64_t nodes_received = 0, particles_received = 0, bytes_received = 0;
-  // Of those received, what this rank's walks visit (nodes) and open (leaves' particles).
+  // Of those received, what this rank's walks visit (nodes) and open
+  // (leaves' particles): counted on checked builds only (0 otherwise).
+  bool checked = false;
   std::uint64_t nodes_used = 0, particles_used = 0;
   // All-gathers (spanning counts, local roots, group boxes): bytes this rank received.
   std::uint64_t bytes_gathered = 0;
@@ -142,6 +145,14 @@ class EssentialTree {
   void add_walk_costs(std::span<std::uint64_t> out) const;
 
   const EssentialTreeStats& stats() const { return stats_; }
+  // build() checks the import on its first call and then on every k-th
+  // (0: never): it replays this rank's group walks over the assembled tree
+  // and throws std::logic_error if one would open a node another rank did
+  // not send. The export is a superset by construction (its test is the
+  // walk's, in double, with a margin), so the check guards against a logic
+  // error, not rounding; run on every build, it costs about twice the rest
+  // of build() (docs/performance/ranks.md).
+  void set_check_every(std::uint64_t k) { check_every_ = k; }
   // The assembled tree (nodes and particles in this rank's layout).
   const LinearOctree<Real>& tree() const { return tree_; }
 
@@ -150,6 +161,7 @@ class EssentialTree {
   GravityField<Real> field_;
   std::size_t own_offset_ = 0, own_count_ = 0, block_size_ = 1024;
   EssentialTreeStats stats_;
+  std::uint64_t check_every_ = 64, builds_ = 0;
 };
 
 extern template KeyCube global_key_cube<float>(const dist::Communicator&, const ParticleSet<float>&);
