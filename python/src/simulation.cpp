@@ -37,6 +37,7 @@
 #include "swirl/io/vtp.hpp"
 #include "swirl/scene/validate.hpp"
 #include "swirl/sim/inlets_outlets.hpp"
+#include "swirl/sim/mechanics.hpp"
 #include "swirl/sim/build.hpp"
 #include "swirl/sim/observer.hpp"
 
@@ -214,7 +215,7 @@ class TypedSimulation final : public AnySimulation {
   }
 
   // The figures of one row of diagnostics.csv (sim/run.cpp's DiagnosticsLog):
-  // energies, momentum, angular momentum about the origin, and every solver's own columns.
+  // energies, momentum, angular momentum about the origin, and every solver's and the stepper's own columns (sim/mechanics.hpp, as the log).
   nb::dict diagnostics() override {
     const Energies e = energies();
     nb::dict d;
@@ -229,13 +230,7 @@ class TypedSimulation final : public AnySimulation {
     for (int k = 0; k < 3; ++k) d[fmt::format("momentum_{}", axes[k]).c_str()] = e.momentum[static_cast<std::size_t>(k)];
     for (int k = 0; k < 3; ++k)
       d[fmt::format("angular_momentum_{}", axes[k]).c_str()] = e.angular[static_cast<std::size_t>(k)];
-    std::vector<double> row;
-    std::vector<std::string> names;
-    for (const auto& s : live().solvers()) {
-      for (const auto& c : s->diagnostic_columns()) names.push_back(c);
-      s->add_diagnostics(live().particles(), block_size_, row);
-    }
-    for (std::size_t k = 0; k < names.size() && k < row.size(); ++k) d[names[k].c_str()] = row[k];
+    for (const auto& [name, value] : sim::diagnostic_values(live(), live().particles(), block_size_)) d[name.c_str()] = value;
     return d;
   }
   nb::dict metrics() override {
@@ -329,18 +324,13 @@ class TypedSimulation final : public AnySimulation {
     double kinetic = 0, potential = 0, total = 0;
     std::array<double, 3> momentum{}, angular{};
   };
+  // The log's sums (sim/mechanics.hpp): block order, boundary particles left out.
   Energies energies() const {
     const auto& p = live().particles();
+    const sim::Mechanics m = sim::mechanics(p, block_size_);
     Energies e;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const double m = p.mass[i];
-      const double x = p.position.x[i], y = p.position.y[i], z = p.position.z[i];
-      const double vx = p.velocity.x[i], vy = p.velocity.y[i], vz = p.velocity.z[i];
-      e.kinetic += 0.5 * m * (vx * vx + vy * vy + vz * vz);
-      e.momentum[0] += m * vx, e.momentum[1] += m * vy, e.momentum[2] += m * vz;
-      e.angular[0] += m * (y * vz - z * vy), e.angular[1] += m * (z * vx - x * vz), e.angular[2] += m * (x * vy - y * vx);
-    }
-    for (const auto& s : live().solvers()) e.potential += s->potential_energy(p, block_size_);
+    e.kinetic = m.kinetic, e.momentum = m.momentum, e.angular = m.angular;
+    e.potential = sim::potential_energy(live(), p, block_size_);
     e.total = e.kinetic + e.potential;
     return e;
   }

@@ -68,6 +68,24 @@ def test_write_frame_splits_boundary_particles_as_the_run_does(swirl, tmp_path):
     assert filecmp.cmp(cli / "particles_000002.vtp", tmp_path / "end.vtp", shallow=False)
 
 
+def test_diagnostics_are_the_logs_row(swirl, tmp_path):
+    # sim.diagnostics() is a row of diagnostics.csv: the same columns (the solvers' and the stepper's own: DFSPH's
+    # iteration counts) and the same numbers as the CLI's log at the same step, to the log's 9 digits.
+    dfsph = 'sph.method="dfsph"'
+    cli = cli_run(tmp_path, "--steps", str(STEPS), "--set", dfsph)
+    header, *rows = (cli / "diagnostics.csv").read_text().splitlines()
+    names, last = header.split(","), rows[-1].split(",")
+    sim = swirl.Simulation(swirl.Scene.from_file(EXAMPLES / "dam_break.toml", overrides=SPH_OVERRIDES + [dfsph]))
+    sim.run(steps=STEPS)
+    d = sim.diagnostics()
+    assert "dfsph_density_iterations" in names
+    for name, text in zip(names, last):
+        if name in ("dt_min", "dt_max", "dt_next", "limited_by"):  # the log's step history since its last row
+            continue
+        assert name in d, name
+        assert d[name] == pytest.approx(float(text), rel=2e-8, abs=1e-12), name
+
+
 def test_summary_and_diagnostics(swirl, sph_scene, tmp_path):
     out = tmp_path / "run"
     summary = swirl.run(sph_scene, out, steps=10, threads=1)

@@ -294,8 +294,7 @@ class DiagnosticsLog final : public Observer<Real> {
       return;
     }
     const Mechanics m = mechanics(p, block_size_);
-    double potential = 0;
-    for (const auto& s : sim.solvers()) potential += s->potential_energy(p, block_size_);
+    const double potential = potential_energy(sim, p, block_size_);
     const double total = m.kinetic + potential;
     std::vector<double> row{sim.time(), m.kinetic, potential, total};
     if (conservative_) {
@@ -331,7 +330,6 @@ class DiagnosticsLog final : public Observer<Real> {
     if (sim.proposed_dt() < std::min(tight.dt, dt_max_)) return "growth";
     return tight.dt <= dt_max_ ? tight.condition : std::string_view("dt_max");
   }
-
 
   std::filesystem::path path_;
   IntervalSchedule schedule_;

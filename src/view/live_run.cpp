@@ -332,8 +332,7 @@ class LiveSession {
     const auto& p = sim_->particles();
     const std::size_t block_size = sim_->settings().block_size;
     const double kinetic = sim::mechanics(p, block_size).kinetic;
-    double potential = 0;
-    for (const auto& s : sim_->solvers()) potential += s->potential_energy(p, block_size);
+    const double potential = sim::potential_energy(*sim_, p, block_size);
     std::string diagnostics;
     for (const auto& [name, value] : sim::diagnostic_values(*sim_, p, block_size))
       diagnostics += fmt::format("{}{}:{}", diagnostics.empty() ? "" : ",", json::string(name), json::number(value));

@@ -9,6 +9,8 @@
 // Boundary particles are left out: their "mass" is a volume weight ψ, and a
 // moving obstacle's prescribed velocity is not the fluid's.
 //
+// potential_energy(): the solvers' potential energies summed (the log's
+// potential_energy column).
 // diagnostic_values(): each solver's columns, then the stepper's, as name and
 // value, in the order of diagnostics.csv's header.
 #include <array>
@@ -54,6 +56,13 @@ Mechanics mechanics(const ParticleSet<Real>& p, std::size_t block_size) {
         return a;
       });
   return {t[0], {t[1], t[2], t[3]}, {t[4], t[5], t[6]}};
+}
+
+template <class Real>
+double potential_energy(const Simulation<Real>& sim, const ParticleSet<Real>& p, std::size_t block_size) {
+  double potential = 0;
+  for (const auto& s : sim.solvers()) potential += s->potential_energy(p, block_size);
+  return potential;
 }
 
 // Names and values of the solvers' and the stepper's own diagnostics for the
