@@ -238,7 +238,8 @@ template <class Real>
 void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSet<Real>& p,
                                 std::span<const std::uint64_t> keys, std::uint64_t first_global_index,
                                 std::span<const std::uint64_t> cut_keys, const KeyCube& cube,
-                                const LinearTreeSettings& settings, std::size_t block_size) {
+                                const LinearTreeSettings& settings, std::size_t block_size,
+                                const ActiveSet& active) {
   const int rank = comm.rank(), ranks = comm.size();
   const std::size_t n = p.size();
   if (settings.walk != Walk::Group) throw std::invalid_argument("essential tree: needs walk = group");
@@ -552,25 +553,38 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
     }
   }
   stats_.groups = own_groups.size();
+  // Each own group's box: of its particles, or with a partly active set of
+  // its active ones (the box LinearOctree::walk_group tests against; a group
+  // without one is not walked, so its box is not sent).
+  struct OwnBox {
+    bool walked = false;
+    Real lo[3] = {}, hi[3] = {};
+  };
+  std::vector<OwnBox> own_boxes(own_groups.size());
+  node_blocks(own_groups.size(), [&](std::size_t b, std::size_t e, std::size_t) {
+    for (std::size_t g = b; g < e; ++g) {
+      OwnBox& box = own_boxes[g];
+      for (std::uint32_t s = own.begin[own_groups[g]]; s < own.end[own_groups[g]]; ++s) {
+        if (!active.contains(s)) continue;
+        const Real x[3] = {px[s], py[s], pz[s]};
+        for (int a = 0; a < 3; ++a) {
+          box.lo[a] = box.walked ? std::min(box.lo[a], x[a]) : x[a];
+          box.hi[a] = box.walked ? std::max(box.hi[a], x[a]) : x[a];
+        }
+        box.walked = true;
+      }
+    }
+  });
   std::vector<std::vector<GroupBox<Real>>> boxes(static_cast<std::size_t>(ranks));
   {
     dist::Bytes b;
     Writer w(b);
-    for (const std::uint32_t node : own_groups) {
-      const std::uint32_t lo_slot = own.begin[node], hi_slot = own.end[node];
-      Real lo[3] = {px[lo_slot], py[lo_slot], pz[lo_slot]}, hi[3] = {px[lo_slot], py[lo_slot], pz[lo_slot]};
-      for (std::uint32_t s = lo_slot; s < hi_slot; ++s) {
-        lo[0] = std::min(lo[0], px[s]);
-        lo[1] = std::min(lo[1], py[s]);
-        lo[2] = std::min(lo[2], pz[s]);
-        hi[0] = std::max(hi[0], px[s]);
-        hi[1] = std::max(hi[1], py[s]);
-        hi[2] = std::max(hi[2], pz[s]);
-      }
-      w.put(first + lo_slot);
-      w.put(first + hi_slot);
-      w.put_array(lo, 3);
-      w.put_array(hi, 3);
+    for (std::size_t g = 0; g < own_groups.size(); ++g) {
+      if (!own_boxes[g].walked) continue;
+      w.put(first + own.begin[own_groups[g]]);
+      w.put(first + own.end[own_groups[g]]);
+      w.put_array(own_boxes[g].lo, 3);
+      w.put_array(own_boxes[g].hi, 3);
     }
     const std::vector<dist::Bytes> all = comm.all_gather(b);
     for (int s = 0; s < ranks; ++s) {
@@ -882,18 +896,11 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
   //    export's excess over the walks' needs.)
   const bool check = check_every_ > 0 && builds_++ % check_every_ == 0;
   std::vector<std::uint8_t> used(check ? total : 0, 0);  // bit 0: visited, bit 1: opened as a leaf
-  for (const std::uint32_t group : groups) {
-    if (!check) break;
+  for (std::size_t g = 0; check && g < groups.size(); ++g) {
+    if (!own_boxes[g].walked) continue;
+    const std::uint32_t group = groups[g];
     const std::uint32_t gb = t.begin[group], ge = t.end[group];
-    Real lo[3] = {tx[gb], ty[gb], tz[gb]}, hi[3] = {tx[gb], ty[gb], tz[gb]};
-    for (std::uint32_t s = gb; s < ge; ++s) {
-      lo[0] = std::min(lo[0], tx[s]);
-      lo[1] = std::min(lo[1], ty[s]);
-      lo[2] = std::min(lo[2], tz[s]);
-      hi[0] = std::max(hi[0], tx[s]);
-      hi[1] = std::max(hi[1], ty[s]);
-      hi[2] = std::max(hi[2], tz[s]);
-    }
+    const Real *lo = own_boxes[g].lo, *hi = own_boxes[g].hi;
     std::vector<std::uint32_t> stack{0};
     while (!stack.empty()) {
       const std::uint32_t node = stack.back();
@@ -923,12 +930,18 @@ void EssentialTree<Real>::build(const dist::Communicator& comm, const ParticleSe
   stats_.tree_nodes = total;
   stats_.tree_particles = tx.size();
   own_count_ = n;
+  slot_active_.clear();
+  if (!active.all()) {  // the assembled tree's slots: this rank's particles at own_offset_, none other active
+    slot_active_.assign(tx.size(), 0);
+    for (std::size_t i = 0; i < n; ++i) slot_active_[own_offset_ + i] = active.contains(i) ? 1 : 0;
+  }
   tree_.assemble(std::move(t), tx, ty, tz, tm, std::move(groups), settings);
 }
 
 template <class Real>
 WalkCounts EssentialTree<Real>::evaluate(GravityField<Real>& out) {
-  const WalkCounts counts = tree_.evaluate(field_, block_size_);
+  const ActiveSet active = slot_active_.empty() ? ActiveSet{} : ActiveSet{slot_active_.data(), 1};
+  const WalkCounts counts = tree_.evaluate(field_, block_size_, active);
   out.resize(own_count_);
   for (std::size_t i = 0; i < own_count_; ++i) {
     out.acceleration.x[i] = field_.acceleration.x[own_offset_ + i];

@@ -90,22 +90,26 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     // every particle's field is the one-rank group walk's, bit for bit.
     if (const std::string no = distributed_support(); !no.empty())
       throw std::invalid_argument("self-gravity on several ranks: " + no + " does not run on several ranks yet");
-    if (!ctx.active.all())
-      throw std::invalid_argument("self-gravity on several ranks: block time steps do not run on several ranks yet");
     const dist::RankOrder<Real>& order = *ctx.ranks;
     const spatial::KeyFrame& f = order.frame();
     const auto t0 = std::chrono::steady_clock::now();
+    // With block time steps only the active particles' groups are exchanged and walked.
     essential_.build(order.comm(), p, order.keys(), order.first_global_index(), order.cut_keys(),
-                     KeyCube{f.corner, f.root_side()}, tree_.linear_settings(), ctx.block_size);
+                     KeyCube{f.corner, f.root_side()}, tree_.linear_settings(), ctx.block_size, ctx.active);
     const auto t1 = std::chrono::steady_clock::now();
     const WalkCounts counts = essential_.evaluate(field_);
-    walked_on_ranks_ = true;
+    walked_on_ranks_ = ctx.active.all();  // walk costs are those of a full evaluation
     // The one-rank figures: exact integer sums over ranks, then its divisions.
-    std::uint64_t sums[2] = {counts.nodes, counts.multipoles + counts.pairs};
+    std::uint64_t active = 0;
+    if (ctx.active.all())
+      active = p.size();
+    else
+      for (std::size_t i = 0; i < p.size(); ++i) active += ctx.active.contains(i);
+    std::uint64_t sums[3] = {counts.nodes, counts.multipoles + counts.pairs, active};
     order.comm().sum(sums);
-    const double n = double(order.global_count());
+    const double n = double(sums[2]);
     stats_ = GravityStats{};
-    stats_.walked = order.global_count();
+    stats_.walked = sums[2];
     stats_.trees = 1;
     stats_.nodes = essential_.stats().tree_nodes;
     stats_.tree_bytes = essential_.tree().bytes();

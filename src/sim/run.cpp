@@ -894,7 +894,6 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
 template <class Real>
 std::string distributed_support_of(const scene::Scene& scene) {
   if (scene.nbody) {
-    if (scene.time_steps == scene::TimeSteps::Block) return "simulation.time_steps = \"block\"";
     const std::string no = gravity::GravityForce<Real>(*scene.nbody).distributed_support();
     if (!no.empty()) return "self-gravity with " + no;
   }

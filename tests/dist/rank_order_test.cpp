@@ -48,7 +48,11 @@ Balanced sort_once(const Communicator& comm, bool weighted) {
   ParticleSet<double> p = whole_set();
   RankOrder<double> order(comm);
   order.set_request({true, 0.05, 0, spatial::CellOrder::Morton});
-  if (weighted) order.set_cost_rule([&p](std::span<std::uint64_t> costs) { heavy_corner(p, costs); });
+  if (weighted)
+    order.set_cost_rule([&p](std::span<std::uint64_t> costs) {
+      heavy_corner(p, costs);
+      return true;
+    });
   order.adopt(p, false);
   order.update(p, 256);
   Balanced b;
@@ -98,6 +102,7 @@ TEST(RankOrder, CutsAreKeptWhileTheImbalanceIsWithinTheThreshold) {
     bool weighted = false;  // from the second sort on, the corner is heavy
     order.set_cost_rule([&](std::span<std::uint64_t> costs) {
       if (weighted) heavy_corner(p, costs);
+      return true;
     });
     order.adopt(p, false);
     order.update(p, 256);
@@ -116,6 +121,42 @@ TEST(RankOrder, CutsAreKeptWhileTheImbalanceIsWithinTheThreshold) {
   }
   RankOrder<double> order(comm);
   EXPECT_THROW(order.set_rebalance_threshold(0.9), std::invalid_argument);
+}
+
+// Block time steps' sub-steps measure no whole step's work: a cost rule that
+// says so keeps the cuts even at threshold 1 and with a heavy corner, and the
+// reported imbalance stays the last measured; the next measured sort
+// rebalances.
+TEST(RankOrder, CutsAreKeptWhenTheLastEvaluationMeasuredNoWholeStep) {
+  const Communicator& comm = Communicator::world();
+  ParticleSet<double> p = whole_set();
+  RankOrder<double> order(comm);
+  order.set_request({true, 0.05, 0, spatial::CellOrder::Morton});
+  order.set_rebalance_threshold(1.0);
+  bool measured = true, heavy = false;
+  order.set_cost_rule([&](std::span<std::uint64_t> costs) {
+    if (heavy) heavy_corner(p, costs);
+    return measured;
+  });
+  order.adopt(p, false);
+  order.update(p, 256);
+  ASSERT_EQ(order.rebalances(), 1u);
+  const double first = order.imbalance();
+  const std::vector<std::uint64_t> cuts(order.cut_keys().begin(), order.cut_keys().end());
+  measured = false, heavy = true;
+  for (std::size_t i = 0; i < p.size(); ++i) p.position.y[i] *= 0.999;
+  order.update(p, 256);
+  EXPECT_EQ(order.rebalances(), 1u) << "not measured: the cuts kept";
+  EXPECT_EQ(order.imbalance(), first) << "not measured: the last measured imbalance";
+  EXPECT_EQ(std::vector<std::uint64_t>(order.cut_keys().begin(), order.cut_keys().end()), cuts);
+  EXPECT_EQ(comm.sum(std::uint64_t(p.size())), kParticles);
+  measured = true;
+  for (std::size_t i = 0; i < p.size(); ++i) p.position.y[i] *= 0.999;
+  order.update(p, 256);
+  if (comm.size() > 1) {
+    EXPECT_EQ(order.rebalances(), 2u) << "measured and imbalanced: new cuts";
+    EXPECT_LT(order.imbalance(), 1.15);
+  }
 }
 
 }  // namespace

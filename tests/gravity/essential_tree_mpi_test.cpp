@@ -272,6 +272,62 @@ TYPED_TEST(EssentialTreeTest, WithinTheOpeningErrorOfTheDirectSum) {
   }
 }
 
+// Block time steps (core/active_set.hpp): with a partly active set, every
+// active particle of every rank gets the one-rank group walk's bits for that
+// active set (the groups without an active particle skipped, a partly active
+// group walked with its active particles' box), and only the walked groups'
+// boxes are exchanged. Two sets: bins scattered over the particles (most
+// groups partly active) and one side of the model active (whole groups idle).
+TYPED_TEST(EssentialTreeTest, ActiveParticlesGetTheOneRankActiveWalksBits) {
+  using Real = TypeParam;
+  const Communicator& comm = Communicator::world();
+  const std::vector<Case> all_cases = cases();
+  for (const std::size_t k : {std::size_t(0), std::size_t(2)}) {
+    const Case& c = all_cases[k];
+    const ParticleSet<Real> all = model<Real>(c.model);
+    for (const bool scattered : {true, false}) {
+      SCOPED_TRACE(c.name + (scattered ? ", scattered bins" : ", the x < 0 side active"));
+      std::vector<std::int32_t> bins(all.size());
+      for (std::size_t i = 0; i < all.size(); ++i)
+        bins[i] = scattered ? std::int32_t((i * 7) % 5) : (all.position.x[i] < 0 ? 3 : 0);
+      const ActiveSet active_all{bins.data(), 3};
+      Part<Real> part = distribute(comm, all, c.settings);
+      std::vector<std::int32_t> mine(part.p.size());
+      for (std::size_t i = 0; i < mine.size(); ++i) mine[i] = bins[part.p.id[i]];
+      EssentialTree<Real> full, tree;
+      full.build(comm, part.p, part.keys, part.distribution.first_global_index, part.cuts, part.cube, c.settings, 64);
+      tree.build(comm, part.p, part.keys, part.distribution.first_global_index, part.cuts, part.cube, c.settings, 64,
+                 ActiveSet{mine.data(), 3});
+      GravityField<Real> field;
+      tree.evaluate(field);
+      ASSERT_EQ(field.size(), part.p.size());
+
+      LinearOctree<Real> one;
+      one.build(all, c.settings, 64);
+      GravityField<Real> ref;
+      one.evaluate(ref, 64, active_all);
+      std::size_t differ = 0, active = 0;
+      for (std::size_t i = 0; i < part.p.size(); ++i) {
+        const std::size_t g = part.p.id[i];
+        if (!active_all.contains(g)) continue;
+        ++active;
+        const Real a[4] = {field.acceleration.x[i], field.acceleration.y[i], field.acceleration.z[i], field.potential[i]};
+        const Real b[4] = {ref.acceleration.x[g], ref.acceleration.y[g], ref.acceleration.z[g], ref.potential[g]};
+        if (std::memcmp(a, b, sizeof(a)) != 0) ++differ;
+      }
+      EXPECT_EQ(differ, 0u) << "of " << active << " active particles on rank " << comm.rank();
+      EXPECT_GT(comm.sum(std::uint64_t(active)), all.size() / 5);
+      EXPECT_EQ(tree.stats().groups, full.stats().groups);
+      if (comm.size() > 1) {
+        EXPECT_LE(tree.stats().bytes_sent, full.stats().bytes_sent);
+        if (!scattered) {
+          EXPECT_LT(tree.stats().bytes_gathered, full.stats().bytes_gathered) << "idle groups' boxes stay home";
+        }
+      }
+    }
+  }
+}
+
 // The export volume at a size of one's choosing (SWIRL_LET_PARTICLES, e.g.
 // 131072; skipped without it): a Plummer sphere with the default settings,
 // its field checked against the one-rank walk as above, the volume printed.

@@ -15,7 +15,8 @@
 //      last evaluation (set_cost_rule: Solver::add_rank_costs, e.g. neighbour
 //      candidates, interaction-list entries; integers, never timings) — kept
 //      from the last sort while the imbalance they give (the largest rank's
-//      cost over the mean) stays within the rebalance threshold; then
+//      cost over the mean) stays within the rebalance threshold, or while the
+//      last evaluation measured no whole step (the rule returns false); then
 //      distribute_in_key_order(): every
 //      particle moves to the rank whose key range holds it, each rank's
 //      particles sorted by (key, previous global index), which is the one-rank
@@ -86,8 +87,12 @@ class RankOrder {
   void set_cut_rule(CutRule rule) { cut_rule_ = std::move(rule); }
 
   // Adds each own particle's work in the last evaluation to costs (one per
-  // particle, in the particles' current order; see the header).
-  using CostRule = std::function<void(std::span<std::uint64_t> costs)>;
+  // particle, in the particles' current order; see the header) and returns
+  // true; or returns false when the last evaluation did not measure a whole
+  // step's work (block time steps' sub-steps evaluate only the active
+  // particles): the cuts are then kept whatever their imbalance (an empty
+  // rank still rebalances, by count) and rank_costs() stays the last measured.
+  using CostRule = std::function<bool(std::span<std::uint64_t> costs)>;
   void set_cost_rule(CostRule rule) { cost_rule_ = std::move(rule); }
   // New cuts when the imbalance of the current ones passes this (≥ 1; 1:
   // new cuts at every sort).
@@ -162,11 +167,12 @@ class RankOrder {
     cells_fit_ = fits;
     keys_ = keys_in_frame(frame_, p);
     costs_.assign(keys_.size(), 1);
-    if (cost_rule_) cost_rule_(costs_);
+    const bool measured = !cost_rule_ || cost_rule_(costs_);
     bool rebalance = !balanced_;
     if (!rebalance) {  // an empty rank (cost 0: every particle costs ≥ 1) always rebalances
       const std::vector<std::uint64_t> held = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
-      rebalance = std::find(held.begin(), held.end(), 0) != held.end() || dist::imbalance(held) > rebalance_threshold_;
+      rebalance = std::find(held.begin(), held.end(), 0) != held.end() ||
+                  (measured && dist::imbalance(held) > rebalance_threshold_);
     }
     if (rebalance) {
       cut_keys_ = balanced_cut_keys(*comm_, keys_, costs_);
@@ -174,7 +180,7 @@ class RankOrder {
       ++rebalances_;
     }
     if (cut_rule_) cut_keys_ = cut_rule_(keys_, std::move(cut_keys_));
-    rank_costs_ = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
+    if (measured || rank_costs_.empty()) rank_costs_ = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
     const Distribution d = distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_, distribute_work_);
     first_ = d.first_global_index;
     global_count_ = d.global_count;

@@ -80,6 +80,7 @@
 #include <span>
 #include <vector>
 
+#include "swirl/core/active_set.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/dist/communicator.hpp"
 #include "swirl/gravity/field.hpp"
@@ -132,16 +133,22 @@ class EssentialTree {
   // (sorted by key; global slots first_global_index ..); keys: theirs, in the
   // cube; cut_keys: the size − 1 cuts the particles were distributed with, on
   // group boundaries (group_aligned_cuts). settings.walk must be group.
-  // Keeps no reference to p.
+  // active: the particles of p (in p's order) whose field the next
+  // evaluate() must give (block time steps, core/active_set.hpp); a partly
+  // active set exchanges and walks only the groups holding active particles,
+  // with the box of their active particles, as LinearOctree's walk does on one
+  // rank. Keeps no reference to p; keeps a copy of active's flags.
   void build(const dist::Communicator& comm, const ParticleSet<Real>& p, std::span<const std::uint64_t> keys,
              std::uint64_t first_global_index, std::span<const std::uint64_t> cut_keys, const KeyCube& cube,
-             const LinearTreeSettings& settings, std::size_t block_size);
+             const LinearTreeSettings& settings, std::size_t block_size, const ActiveSet& active = {});
 
   // The field of this rank's particles (out resized to their count, in p's
-  // order): the one-rank group walk's bits. Not collective.
+  // order): the one-rank group walk's bits, for the active particles of the
+  // last build() (the others' entries are unspecified). Not collective.
   WalkCounts evaluate(GravityField<Real>& out);
-  // After evaluate(): adds to out (one entry per own particle, in p's order)
-  // each one's interaction-list length (LinearOctree::add_walk_costs).
+  // After evaluate() of a build with every particle active: adds to out (one
+  // entry per own particle, in p's order) each one's interaction-list length
+  // (LinearOctree::add_walk_costs).
   void add_walk_costs(std::span<std::uint64_t> out) const;
 
   const EssentialTreeStats& stats() const { return stats_; }
@@ -159,6 +166,7 @@ class EssentialTree {
  private:
   LinearOctree<Real> tree_;
   GravityField<Real> field_;
+  std::vector<std::int32_t> slot_active_;  // per slot of the assembled tree: 1 active; empty: all
   std::size_t own_offset_ = 0, own_count_ = 0, block_size_ = 1024;
   EssentialTreeStats stats_;
   std::uint64_t check_every_ = 64, builds_ = 0;

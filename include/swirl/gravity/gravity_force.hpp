@@ -105,7 +105,7 @@ class GravityForce final : public Solver<Real> {
   SelfGravityOptions options_;
   BarnesHut<Real> tree_;
   EssentialTree<Real> essential_;  // on several ranks
-  bool walked_on_ranks_ = false;     // essential_ has evaluated the particles now held
+  bool walked_on_ranks_ = false;     // essential_ has evaluated every particle now held
   Fmm<Real> fmm_;
   GravityField<Real> field_;
   GravityStats stats_;

@@ -190,8 +190,8 @@ class LinearOctree {
   // (node indices, each node's particles all given). evaluate() then walks
   // these groups only, over these nodes, with the group walk unchanged, and
   // writes the field of their particles (indexed by slot; the other slots'
-  // entries are left as they were). Needs walk = group; evaluate() then takes
-  // no active set.
+  // entries are left as they were). Needs walk = group; an active set given
+  // to evaluate() is indexed by slot (the particles given here).
   void assemble(LinearNodes<Real> nodes, std::span<const Real> x, std::span<const Real> y, std::span<const Real> z,
                 std::span<const Real> m, std::vector<std::uint32_t> groups, const LinearTreeSettings& settings);
 

@@ -35,7 +35,9 @@
 // order and the tree are refreshed for all particles at every sub-step.
 //
 // Determinism: every pass runs over fixed blocks and writes only its own
-// block; the finest bin is a max-reduction: bit-identical for any thread count.
+// block; the finest bin is a max-reduction (over the ranks too: each rank
+// steps its own particles, StepRequest::ranks): bit-identical for any thread
+// and rank count.
 // No walls: a box's reflections belong to a whole step (the scene refuses
 // block steps with walls).
 #pragma once
@@ -52,6 +54,7 @@
 
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/phase_timers.hpp"
+#include "swirl/dist/communicator.hpp"
 #include "swirl/force/step_scan.hpp"
 #include "swirl/integrate/stepper.hpp"
 #include "swirl/parallel/for_blocks.hpp"
@@ -112,6 +115,7 @@ class BlockStepper final : public Stepper<Real> {
             return finest;
           },
           [](std::int32_t x, std::int32_t y) { return std::max(x, y); });
+      finest_ = global_finest(r, finest_);
     }
     std::uint64_t n = 0;
     while (n < total) {
@@ -161,8 +165,8 @@ class BlockStepper final : public Stepper<Real> {
             return f;
           },
           [](Fold x, const Fold& y) { return Fold{std::max(x.finest, y.finest), x.active + y.active}; });
-      finest_ = fold.finest;
-      active_updates_ += double(fold.active);
+      finest_ = global_finest(r, fold.finest);
+      active_updates_ += double(r.ranks ? r.ranks->sum(fold.active) : fold.active);
     }
     ++steps_;
     StepOutcome out;
@@ -201,6 +205,14 @@ class BlockStepper final : public Stepper<Real> {
     const std::size_t k = p.find_int_field(kTimeBinField);
     if (k == ParticleSet<Real>::npos) throw std::logic_error("BlockStepper: time bins not declared");
     return p.int_field(k).data();
+  }
+
+  // On several ranks every rank takes the sub-steps of the finest bin of all.
+  static std::int32_t global_finest(const StepRequest& r, std::int32_t mine) {
+    if (!r.ranks) return mine;
+    double finest[1] = {double(mine)};
+    r.ranks->max(finest);
+    return std::int32_t(finest[0]);
   }
 
   // ½·Δt / 2^k, exact in double and rounded once.

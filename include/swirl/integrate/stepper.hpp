@@ -26,6 +26,10 @@
 #include "swirl/core/phase_timers.hpp"
 #include "swirl/force/step_scan.hpp"
 
+namespace swirl::dist {
+class Communicator;
+}
+
 namespace swirl::integrate {
 
 // The integer field of individual time steps: each particle's bin
@@ -54,6 +58,10 @@ struct StepRequest {
   ScanNeeds needs;             // what the scan measures beyond |v|max, |a|max
   double escape_length = 0;    // > 0 with a box: report the particle furthest outside beyond this
   PhaseTimers* timers = nullptr;
+  // Several ranks (each stepping its own particles): what a stepper decides
+  // for all particles at once (the block stepper's finest bin) is reduced
+  // over them. Null: one rank.
+  const dist::Communicator* ranks = nullptr;
 };
 
 // A particle that ended a position update further outside the box than

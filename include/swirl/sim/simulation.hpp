@@ -214,9 +214,7 @@ class Simulation {
         for (const auto& s : solvers_) cuts = s->rank_cuts(ranks_->comm(), keys, std::move(cuts));
         return cuts;
       });
-      ranks_->set_cost_rule([this](std::span<std::uint64_t> costs) {
-        for (const auto& s : solvers_) s->add_rank_costs(costs);
-      });
+      ranks_->set_cost_rule([this](std::span<std::uint64_t> costs) { return add_rank_costs(costs); });
     }
     if (request.keep_within > 0) particles_.add_field(std::string(spatial::ParticleOrder<Real>::kReferenceField), 3, FieldUse::Internal);
     prepared_ = true;
@@ -321,6 +319,7 @@ class Simulation {
     request.needs = needs_;
     request.escape_length = checks ? settings_.escape_length : 0;
     request.timers = &timers_;
+    request.ranks = ranks_ ? &ranks_->comm() : nullptr;
     Evaluation forces(*this);
     const integrate::StepOutcome outcome = stepper_->advance(particles_, forces, request);
     scan_ = global_scan(outcome.scan);
@@ -448,6 +447,7 @@ class Simulation {
     }
     SolverContext<Real> ctx{t, settings_.block_size, &timers_, order_.active() && !ranks_ ? &order_ : nullptr, {},
                             ranks_.get()};
+    last_evaluation_partial_ = min_bin > 0;
     if (min_bin > 0) {
       const std::size_t bins = particles_.find_int_field(integrate::kTimeBinField);
       if (bins == ParticleSet<Real>::npos) throw std::logic_error("Simulation: an active evaluation without time bins");
@@ -455,6 +455,26 @@ class Simulation {
     }
     for (auto& s : solvers_) s->add_acceleration(particles_, ctx);
     hold_boundary_particles();
+  }
+
+  // The cost rule of the cuts (dist::RankOrder::set_cost_rule): the solvers'
+  // counts of each particle's work in the last evaluation. With time bins
+  // (block time steps) a particle in bin k is evaluated 2^k times a step, so
+  // its work counts 2^min(k, 16) times (the cap keeps the sums of 10^8
+  // particles within 64 bits); an evaluation of the active particles only
+  // measured no whole step: false, the cuts are kept.
+  bool add_rank_costs(std::span<std::uint64_t> costs) {
+    if (last_evaluation_partial_) return false;
+    const std::size_t k = particles_.find_int_field(integrate::kTimeBinField);
+    if (k == ParticleSet<Real>::npos || costs.size() != particles_.size()) {
+      for (const auto& s : solvers_) s->add_rank_costs(costs);
+      return true;
+    }
+    rank_work_.assign(costs.size(), 0);
+    for (const auto& s : solvers_) s->add_rank_costs(rank_work_);
+    const std::int32_t* bin = particles_.int_field(k).data();
+    for (std::size_t i = 0; i < costs.size(); ++i) costs[i] += rank_work_[i] << std::clamp(bin[i], 0, 16);
+    return true;
   }
 
   // Boundary particles (core/particle_kind.hpp) are not integrated: their
@@ -659,6 +679,8 @@ class Simulation {
   std::shared_ptr<const boundary::MovingBoundaries> moving_;  // null: every boundary particle static
   std::unique_ptr<dist::RankOrder<Real>> ranks_;  // several ranks: the global order (order_ unused)
   std::uint64_t evaluations_on_ranks_ = 0;
+  bool last_evaluation_partial_ = false;    // the last compute_forces() was of the active particles only
+  std::vector<std::uint64_t> rank_work_;    // add_rank_costs()'s solver counts, before the bins' weights
   bool whole_on_root_ = false;  // distribute(): the set on rank 0 alone until start() or resume()
   mutable ParticleSet<Real> gathered_;  // whole_particles() on ranks (filled on rank 0)
   mutable std::pair<std::uint64_t, std::uint64_t> gathered_stamp_{};  // the step and epoch it was gathered at
