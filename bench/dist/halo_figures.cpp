@@ -96,9 +96,9 @@ int run(int argc, char** argv) {
   const Summary own_s = over_ranks(comm, own), ghost_s = over_ranks(comm, ghosts);
   // The largest ratio of ghosts to own particles on one rank, in parts per million.
   const Summary ratio = over_ranks(comm, own > 0 ? ghosts * 1000000 / own : 0);
-  const Summary ask = over_ranks(comm, halo.request_traffic().bytes),
-                ins = over_ranks(comm, halo.insert_traffic().bytes),
-                ref = over_ranks(comm, halo.refresh_traffic().bytes),
+  const Summary ask = over_ranks(comm, halo.request_traffic().bytes_sent),
+                ins = over_ranks(comm, halo.insert_traffic().bytes_sent),
+                ref = over_ranks(comm, halo.refresh_traffic().bytes_sent),
                 msg = over_ranks(comm, halo.insert_traffic().messages);
   if (comm.is_root()) {
     std::printf("particles %llu (%llu^3), ranks %d, cells %.4g m (h + %.2g spacings)\n", (unsigned long long)count,

@@ -59,7 +59,10 @@ void allreduce_in_place(void* values, std::size_t count, MPI_Datatype type, MPI_
 
 void Communicator::sum(std::span<std::uint64_t> values) const {
 #if SWIRL_WITH_MPI
-  if (mpi_ && !values.empty()) allreduce_in_place(values.data(), values.size(), MPI_UINT64_T, MPI_SUM, "sum");
+  if (mpi_ && !values.empty()) {
+    allreduce_in_place(values.data(), values.size(), MPI_UINT64_T, MPI_SUM, "sum");
+    tally(1, values.size_bytes(), values.size_bytes());
+  }
 #else
   (void)values;
 #endif
@@ -67,7 +70,10 @@ void Communicator::sum(std::span<std::uint64_t> values) const {
 
 void Communicator::min(std::span<double> values) const {
 #if SWIRL_WITH_MPI
-  if (mpi_ && !values.empty()) allreduce_in_place(values.data(), values.size(), MPI_DOUBLE, MPI_MIN, "min");
+  if (mpi_ && !values.empty()) {
+    allreduce_in_place(values.data(), values.size(), MPI_DOUBLE, MPI_MIN, "min");
+    tally(1, values.size_bytes(), values.size_bytes());
+  }
 #else
   (void)values;
 #endif
@@ -75,7 +81,10 @@ void Communicator::min(std::span<double> values) const {
 
 void Communicator::max(std::span<double> values) const {
 #if SWIRL_WITH_MPI
-  if (mpi_ && !values.empty()) allreduce_in_place(values.data(), values.size(), MPI_DOUBLE, MPI_MAX, "max");
+  if (mpi_ && !values.empty()) {
+    allreduce_in_place(values.data(), values.size(), MPI_DOUBLE, MPI_MAX, "max");
+    tally(1, values.size_bytes(), values.size_bytes());
+  }
 #else
   (void)values;
 #endif
@@ -96,7 +105,11 @@ std::uint64_t Communicator::exclusive_prefix_sum(std::uint64_t value) const {
 std::vector<std::uint64_t> Communicator::all_gather(std::uint64_t value) const {
   std::vector<std::uint64_t> all(static_cast<std::size_t>(size_), value);
 #if SWIRL_WITH_MPI
-  if (mpi_) check(MPI_Allgather(&value, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD), "MPI_Allgather");
+  if (mpi_) {
+    check(MPI_Allgather(&value, 1, MPI_UINT64_T, all.data(), 1, MPI_UINT64_T, MPI_COMM_WORLD), "MPI_Allgather");
+    const auto others = std::uint64_t(size_ - 1);
+    tally(others, others * sizeof(value), others * sizeof(value));
+  }
 #endif
   return all;
 }
@@ -126,10 +139,16 @@ std::vector<Bytes> Communicator::all_to_all(const std::vector<Bytes>& send) cons
                         recv_counts.data(), recv_offsets.data(), MPI_BYTE, MPI_COMM_WORLD),
           "MPI_Alltoallv");
     std::vector<Bytes> received(n);
+    std::uint64_t messages = 0, sent = 0, got = 0;
     for (std::size_t s = 0; s < n; ++s) {
       const auto begin = recv_flat.begin() + recv_offsets[s];
       received[s].assign(begin, begin + recv_counts[s]);
+      if (s == static_cast<std::size_t>(rank_)) continue;
+      messages += send[s].empty() ? 0 : 1;
+      sent += send[s].size();
+      got += received[s].size();
     }
+    tally(messages, sent, got);
     return received;
   }
 #endif
@@ -154,6 +173,8 @@ std::vector<Bytes> Communicator::all_gather(const Bytes& mine) const {
           "MPI_Allgatherv");
     std::vector<Bytes> all(n);
     for (std::size_t s = 0; s < n; ++s) all[s].assign(flat.begin() + offsets[s], flat.begin() + offsets[s] + counts[s]);
+    const auto others = std::uint64_t(size_ - 1);
+    tally(others, others * mine.size(), total - mine.size());
     return all;
   }
 #endif
@@ -190,6 +211,9 @@ std::vector<Bytes> Communicator::gather_to_root(const Bytes& mine) const {
     if (is_root()) {
       all.resize(n);
       for (std::size_t s = 0; s < n; ++s) all[s].assign(flat.begin() + offsets[s], flat.begin() + offsets[s] + counts[s]);
+      tally(0, 0, total - mine.size());
+    } else {
+      tally(1, mine.size(), 0);
     }
     return all;
   }
@@ -199,7 +223,10 @@ std::vector<Bytes> Communicator::gather_to_root(const Bytes& mine) const {
 
 void Communicator::barrier() const {
 #if SWIRL_WITH_MPI
-  if (mpi_) check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");
+  if (mpi_) {
+    check(MPI_Barrier(MPI_COMM_WORLD), "MPI_Barrier");
+    tally(0, 0, 0);
+  }
 #endif
 }
 

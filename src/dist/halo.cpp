@@ -40,7 +40,7 @@ Traffic Halo::traffic_of(const std::vector<Bytes>& send, int self) {
   Traffic t;
   for (std::size_t d = 0; d < send.size(); ++d) {
     if (static_cast<int>(d) == self || send[d].empty()) continue;
-    t.bytes += send[d].size();
+    t.bytes_sent += send[d].size();
     ++t.messages;
   }
   return t;

@@ -97,6 +97,9 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     essential_.build(order.comm(), p, order.keys(), order.first_global_index(), order.cut_keys(),
                      KeyCube{f.corner, f.root_side()}, tree_.linear_settings(), ctx.block_size, ctx.active);
     const auto t1 = std::chrono::steady_clock::now();
+    imported_nodes_ += double(essential_.stats().nodes_received);
+    imported_particles_ += double(essential_.stats().particles_received);
+    own_particles_ += double(p.size());
     const WalkCounts counts = essential_.evaluate(field_);
     walked_on_ranks_ = ctx.active.all();  // walk costs are those of a full evaluation
     // The one-rank figures: exact integer sums over ranks, then its divisions.
@@ -235,6 +238,13 @@ void GravityForce<Real>::add_metrics(NamedValues& out) const {
   out.emplace_back("particle_force_evaluations", particle_evaluations_);
   if (stats_.tree_bytes > 0 && particles_ > 0)
     out.emplace_back("tree_bytes_per_particle", double(stats_.tree_bytes) / double(particles_));
+}
+
+template <class Real>
+void GravityForce<Real>::add_rank_metrics(NamedValues& out) const {
+  // What the locally essential trees imported, per own particle (the export's volume).
+  out.emplace_back("let_nodes_per_particle", own_particles_ > 0 ? imported_nodes_ / own_particles_ : 0.0);
+  out.emplace_back("let_particles_per_particle", own_particles_ > 0 ? imported_particles_ / own_particles_ : 0.0);
 }
 
 template <class Real>

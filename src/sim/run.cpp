@@ -621,6 +621,26 @@ std::pair<io::CheckpointHeader, NamedValues> share_checkpoint_values(
   return out;
 }
 
+// Each rank's figures (the same names on every rank) as "<name>_mean" and
+// "<name>_max" over the ranks. Collective.
+void add_over_ranks(const dist::Communicator& comm, const NamedValues& mine, NamedValues& out) {
+  std::vector<double> values;
+  for (const auto& [name, value] : mine) values.push_back(value);
+  const std::vector<dist::Bytes> all = comm.all_gather(dist::to_bytes(std::span<const double>(values)));
+  for (std::size_t k = 0; k < mine.size(); ++k) {
+    double sum = 0, largest = -std::numeric_limits<double>::infinity();
+    for (const dist::Bytes& b : all) {
+      std::vector<double> theirs;
+      dist::append_values(b, theirs, "rank metrics");
+      if (theirs.size() != values.size()) throw std::logic_error("rank metrics: the ranks report different figures");
+      sum += theirs[k];
+      largest = std::max(largest, theirs[k]);
+    }
+    out.emplace_back(mine[k].first + "_mean", sum / double(all.size()));
+    out.emplace_back(mine[k].first + "_max", largest);
+  }
+}
+
 // What stopped a stage of the loop: a blow-up, a failed write; empty: nothing.
 struct Failure {
   std::string error;
@@ -831,6 +851,7 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
     return asked[0] > 0;
   };
 
+  dist::Traffic step_traffic;  // this rank's, inside the steps (not the set-up, frames or checkpoints)
   bool going = stage([&] {
     if (!options.resume) sim.start();  // solvers fill their fields (density, potential) here
     summary.bytes_per_particle = bytes_per_particle(sim);
@@ -844,7 +865,9 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
         for (const Observer<Real>* o : observers)
           if (const auto t = o->next_time(sim); t && (!land || *t < *land)) land = t;
       }
+      const dist::Traffic before = comm.traffic();
       sim.step(land);
+      step_traffic += comm.traffic() - before;
       for (Observer<Real>* o : observers) o->on_step(sim);
     });
     if (going && stop_asked()) {
@@ -880,6 +903,15 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
       summary.metrics.emplace_back("rebalances", double(sim.ranks()->rebalances()));
       summary.metrics.emplace_back("rank_imbalance", sim.ranks()->imbalance());
     }
+    // Communication per step (dist::Traffic) and the solvers' own per-rank
+    // figures (halo and imported-tree fractions), as mean and max over ranks.
+    const double steps = std::max(double(summary.steps), 1.0);
+    NamedValues mine{{"mpi_collectives_per_step", double(step_traffic.collectives) / steps},
+                     {"mpi_messages_per_step", double(step_traffic.messages) / steps},
+                     {"mpi_bytes_sent_per_step", double(step_traffic.bytes_sent) / steps},
+                     {"mpi_bytes_received_per_step", double(step_traffic.bytes_received) / steps}};
+    for (const auto& s : sim.solvers()) s->add_rank_metrics(mine);
+    add_over_ranks(comm, mine, summary.metrics);
   } else if (sim.order().active()) {
     summary.metrics.emplace_back("sorts", double(sim.order().sorts()));
   }

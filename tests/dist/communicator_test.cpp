@@ -81,5 +81,45 @@ TEST(Communicator, GatherToRootKeepsRankOrder) {
   }
 }
 
+// The traffic counters: each operation's logical messages and bytes, exact
+// (one rank moves nothing).
+TEST(Communicator, TrafficCountsEachOperationsPayloads) {
+  const Communicator& comm = Communicator::world();
+  const auto n = static_cast<std::uint64_t>(comm.size()), r = static_cast<std::uint64_t>(comm.rank());
+  const std::uint64_t others = n - 1;
+  auto measure = [&](auto&& operation) {
+    const Traffic before = comm.traffic();
+    operation();
+    return comm.traffic() - before;
+  };
+  auto expect = [&](const Traffic& t, std::uint64_t collectives, std::uint64_t messages, std::uint64_t sent,
+                    std::uint64_t received, const char* what) {
+    SCOPED_TRACE(what);
+    if (n == 1) collectives = messages = sent = received = 0;
+    EXPECT_EQ(t.collectives, collectives);
+    EXPECT_EQ(t.messages, messages);
+    EXPECT_EQ(t.bytes_sent, sent);
+    EXPECT_EQ(t.bytes_received, received);
+  };
+  std::vector<std::uint64_t> three(3, r);
+  expect(measure([&] { comm.sum(three); }), 1, 1, 24, 24, "a sum of three");
+  expect(measure([&] { comm.all_gather(r); }), 1, others, 8 * others, 8 * others, "an all-gather of one value");
+  // Rank s sends s + d bytes to rank d: to itself and to rank 0 from rank 0 nothing.
+  std::vector<Bytes> send(n);
+  for (std::uint64_t d = 0; d < n; ++d) send[d].assign(r + d, std::byte(1));
+  std::uint64_t messages = 0, sent = 0, received = 0;
+  for (std::uint64_t d = 0; d < n; ++d)
+    if (d != r) messages += r + d > 0 ? 1 : 0, sent += r + d, received += d + r;
+  expect(measure([&] { comm.all_to_all(send); }), 1, messages, sent, received, "an all-to-all");
+  // Rank s contributes 2·s bytes.
+  std::uint64_t everyone = 0;
+  for (std::uint64_t s = 0; s < n; ++s) everyone += 2 * s;
+  expect(measure([&] { comm.all_gather(Bytes(2 * r, std::byte(0))); }), 1, others, 2 * r * others, everyone - 2 * r,
+         "an all-gather of bytes");
+  expect(measure([&] { comm.gather_to_root(Bytes(2 * r, std::byte(0))); }), 1, comm.is_root() ? 0 : 1,
+         comm.is_root() ? 0 : 2 * r, comm.is_root() ? everyone : 0, "a gather to rank 0");
+  expect(measure([&] { comm.barrier(); }), 1, 0, 0, 0, "a barrier");
+}
+
 }  // namespace
 }  // namespace swirl::dist

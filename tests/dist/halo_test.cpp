@@ -218,7 +218,7 @@ TEST_P(HaloTest, EqualsTheBruteForceSearchBeforeAndAfterMigration) {
   for (std::size_t i = 0; i < r.p.size(); ++i) EXPECT_EQ(r.p.extra(temperature)[i], 300.0 + double(r.p.id[i]));
 
   // Figures for docs/design/mpi.md: ghosts and halo (within h + skin) per particle, bytes per rank.
-  std::vector<std::uint64_t> totals{first[0], first[1], second[0], insert.bytes, refresh.bytes, ask.bytes,
+  std::vector<std::uint64_t> totals{first[0], first[1], second[0], insert.bytes_sent, refresh.bytes_sent, ask.bytes_sent,
                                     insert.messages};
   comm.sum(totals);
   if (comm.is_root())

@@ -78,6 +78,15 @@ for n in 2 3 4; do
   [ "$(grep -c 'swirl run: done' "$out/stdout")" -eq 1 ] || fail "float on $n ranks: the summary is not printed exactly once"
 done
 
+# 1b. The summary's communication figures (dist::Traffic, inside the steps)
+#     and the halo's ghosts per particle, as mean and max over 2 ranks.
+on_ranks 2 run "$scene" "${small[@]}" --steps 3 --out "$out/traffic" --summary-json "$out/traffic.json"
+[ "$status" -eq 0 ] || { fail "traffic on 2 ranks: status $status"; cat "$out/stderr"; }
+for key in mpi_collectives_per_step_mean mpi_messages_per_step_max mpi_bytes_sent_per_step_mean \
+           mpi_bytes_received_per_step_max halo_ghosts_per_particle_mean; do
+  grep -Eq "\"$key\": *[0-9.]*[1-9]" "$out/traffic.json" || fail "traffic on 2 ranks: no positive $key in the summary"
+done
+
 # 2. Double, adaptive steps, Morton cells with a Verlet skin (the order kept
 #    while no particle of any rank moved half the skin): 3 ranks against one.
 dbl=("${small[@]}" --set 'simulation.precision="double"' --set 'simulation.dt="adaptive"'

@@ -49,6 +49,29 @@ void append_values(const Bytes& b, std::vector<T>& out, const char* what) {
   if (!b.empty()) std::memcpy(out.data() + at, b.data(), b.size());
 }
 
+// What one rank's collectives moved (counted on several ranks only; a single
+// rank moves nothing). A logical count, independent of how MPI routes the
+// data: each payload this rank hands to another rank is one message of its
+// bytes — all_to_all's non-empty buffers, an all-gather's contribution once
+// per other rank, a reduction's values once, a gather's contribution from a
+// rank other than 0 — and the bytes received likewise.
+struct Traffic {
+  std::uint64_t collectives = 0;  // operations called (each one or two MPI collectives)
+  std::uint64_t messages = 0;     // payloads sent to other ranks
+  std::uint64_t bytes_sent = 0;
+  std::uint64_t bytes_received = 0;
+
+  Traffic& operator+=(const Traffic& o) {
+    collectives += o.collectives, messages += o.messages, bytes_sent += o.bytes_sent, bytes_received += o.bytes_received;
+    return *this;
+  }
+  friend Traffic operator-(Traffic a, const Traffic& b) {
+    a.collectives -= b.collectives, a.messages -= b.messages, a.bytes_sent -= b.bytes_sent;
+    a.bytes_received -= b.bytes_received;
+    return a;
+  }
+};
+
 class Communicator {
  public:
   // The ranks of this process's run: MPI_COMM_WORLD under an MpiSession, one rank otherwise.
@@ -89,7 +112,16 @@ class Communicator {
   // Ends every rank of the run with this exit status (never returns).
   [[noreturn]] void abort(int exit_status) const;
 
+  // This rank's traffic since the start (see Traffic); differences of two
+  // readings measure what lay between them.
+  const Traffic& traffic() const { return traffic_; }
+
  private:
+  // Counts one operation (only the thread that calls MPI does: MPI_THREAD_FUNNELED).
+  void tally(std::uint64_t messages, std::uint64_t sent, std::uint64_t received) const {
+    if (size_ > 1) traffic_ += Traffic{1, messages, sent, received};
+  }
+  mutable Traffic traffic_;
   Communicator() = default;
   friend class MpiSession;
   int rank_ = 0;

@@ -112,12 +112,6 @@ std::vector<std::uint64_t> keys_in_frame(const spatial::KeyFrame& f, const Parti
   return keys;
 }
 
-// Bytes and messages (non-empty buffers) this rank sent in one exchange.
-struct Traffic {
-  std::uint64_t bytes = 0;
-  std::uint64_t messages = 0;
-};
-
 class Halo {
  public:
   Halo() = default;

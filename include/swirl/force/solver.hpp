@@ -132,6 +132,10 @@ class Solver {
   virtual bool conserves_energy() const { return true; }
   // Summary figures over the run so far, e.g. {"mean_neighbours", 24.9}.
   virtual void add_metrics(NamedValues& /*out*/) const {}
+  // On several ranks: this rank's own figures over the run so far, e.g.
+  // {"halo_ghosts_per_particle", 0.13}; the run reports each as its mean and
+  // its largest value over the ranks (every rank must add the same names).
+  virtual void add_rank_metrics(NamedValues& /*out*/) const {}
   // Bytes the solver keeps between evaluations (search structures, scratch).
   virtual std::size_t scratch_bytes() const { return 0; }
 

@@ -84,6 +84,7 @@ class GravityForce final : public Solver<Real> {
                        std::vector<double>& row) const override;
   double potential_energy(const ParticleSet<Real>& particles, std::size_t block_size) const override;
   void add_metrics(NamedValues& out) const override;
+  void add_rank_metrics(NamedValues& out) const override;
   std::size_t scratch_bytes() const override { return stats_.tree_bytes; }
   void save_state(NamedValues& out) const override;
   void load_state(const NamedValues& values) override;
@@ -106,6 +107,9 @@ class GravityForce final : public Solver<Real> {
   BarnesHut<Real> tree_;
   EssentialTree<Real> essential_;  // on several ranks
   bool walked_on_ranks_ = false;     // essential_ has evaluated every particle now held
+  // On ranks, summed over builds: the essential tree's imported nodes and
+  // particles, and this rank's own particles.
+  double imported_nodes_ = 0, imported_particles_ = 0, own_particles_ = 0;
   Fmm<Real> fmm_;
   GravityField<Real> field_;
   GravityStats stats_;

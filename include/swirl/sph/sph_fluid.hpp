@@ -517,6 +517,10 @@ class SphFluid final : public Solver<Real> {
   void add_metrics(NamedValues& out) const override {
     out.emplace_back("mean_neighbours", evaluations_ > 0 ? neighbour_sum_ / double(evaluations_) : mean_neighbours_);
   }
+  // The ghosts over the rank's own particles, summed over this run's evaluations.
+  void add_rank_metrics(NamedValues& out) const override {
+    out.emplace_back("halo_ghosts_per_particle", halo_owned_sum_ > 0 ? halo_ghost_sum_ / halo_owned_sum_ : 0.0);
+  }
   void save_state(NamedValues& out) const override {
     out.emplace_back("sph.neighbour_sum", neighbour_sum_);
     out.emplace_back("sph.evaluations", double(evaluations_));
@@ -870,6 +874,8 @@ class SphFluid final : public Solver<Real> {
       halo = dist::Halo::find(comm, order.frame(), halo_keys_, order.first_global_index(), order.global_count(),
                               order.cut_keys(), kHaloTail<Real>);
       halo.insert(comm, p, halo_keys_, exchange_fields(p));
+      halo_ghost_sum_ += double(halo.ghost_count());
+      halo_owned_sum_ += double(halo.owned_count());
     }
     {
       PhaseScope phase(ctx, "forces.cells");
@@ -975,6 +981,8 @@ class SphFluid final : public Solver<Real> {
                                order.cut_keys(), kHaloTail<Real>);
       if (kinds(p)) reaction_halo_ = halo_;  // before insert(): boundary_forces(), record_density_reaction()
       halo_.insert(comm, local_, halo_keys_, exchange_fields(p));
+      halo_ghost_sum_ += double(halo_.ghost_count());
+      halo_owned_sum_ += double(halo_.owned_count());
       own_ = halo_.owned();
     }
     {
@@ -1172,6 +1180,7 @@ class SphFluid final : public Solver<Real> {
   double mean_neighbours_ = 0;
   std::vector<std::uint64_t> rank_costs_;  // on ranks: the own particles' costs (add_rank_costs)
   double neighbour_sum_ = 0;     // Σ of mean_neighbours_ over evaluations (the summary's mean)
+  double halo_ghost_sum_ = 0, halo_owned_sum_ = 0;  // on ranks: Σ ghosts and Σ own particles over evaluations
   std::uint64_t evaluations_ = 0;
   bool used_grid_ = false;
   bool boundary_volumes_ = false;  // ψ_b computed into the boundary particles' masses (state)
