@@ -53,6 +53,7 @@ bool GravityForce<Real>::views_order() const {
 
 template <class Real>
 std::string GravityForce<Real>::distributed_support() const {
+  if (settings_.method == Method::Direct) return {};
   if (settings_.method != Method::BarnesHut) return fmt::format("nbody.method = \"{}\"", to_string(settings_.method));
   if (!views_order()) return "a Barnes-Hut tree other than the linear octree over the particle order";
   if (settings_.walk != Walk::Group) return "nbody.walk = \"particle\"";
@@ -83,9 +84,65 @@ spatial::OrderRequest GravityForce<Real>::order_request() const {
   return {};
 }
 
+namespace {
+
+// The direct sum on several ranks: every rank gathers every rank's positions
+// and masses in rank order — the one-rank memory order (dist/rank_order.hpp)
+// — and sums over all of them for its own active particles with the one-rank
+// direct_sum(), whose sum for a particle depends only on the whole set's
+// order: the one-rank bits. O(N) memory per rank, as the O(N²) method's sizes
+// allow. Fills own (one entry per own particle) and returns the global count
+// of active particles. Collective.
+template <class Real>
+std::uint64_t direct_sum_on_ranks(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p, Real softening,
+                                  std::size_t block_size, const ActiveSet& active, GravityField<Real>& own) {
+  const dist::Communicator& comm = order.comm();
+  const std::size_t n = p.size();
+  std::vector<Real> mine;
+  mine.reserve(4 * n);
+  for (const auto* a : {&p.position.x, &p.position.y, &p.position.z, &p.mass}) mine.insert(mine.end(), a->begin(), a->end());
+  ParticleSet<Real> all(order.global_count());
+  std::size_t at = 0;
+  for (const dist::Bytes& b : comm.all_gather(dist::to_bytes(std::span<const Real>(mine)))) {
+    std::vector<Real> theirs;
+    dist::append_values(b, theirs, "direct sum on ranks");
+    const std::size_t count = theirs.size() / 4;
+    if (theirs.size() % 4 != 0 || at + count > all.size())
+      throw std::runtime_error("direct sum on ranks: a rank sent a partial set");
+    for (int a = 0; a < 3; ++a) std::copy_n(theirs.data() + a * count, count, all.position[a].data() + at);
+    std::copy_n(theirs.data() + 3 * count, count, all.mass.data() + at);
+    at += count;
+  }
+  if (at != all.size()) throw std::runtime_error("direct sum on ranks: the ranks hold another particle count");
+  // Only this rank's own active particles are summed.
+  std::vector<std::int32_t> flags(all.size(), 0);
+  const std::size_t first = order.first_global_index();
+  std::uint64_t active_count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    flags[first + i] = active.contains(i) ? 1 : 0;
+    active_count += std::uint64_t(flags[first + i]);
+  }
+  GravityField<Real> field;
+  direct_sum(all, softening, block_size, field, ActiveSet{flags.data(), 1});
+  own.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int a = 0; a < 3; ++a) own.acceleration[a][i] = field.acceleration[a][first + i];
+    own.potential[i] = field.potential[first + i];
+  }
+  return comm.sum(active_count);
+}
+
+}  // namespace
+
 template <class Real>
 void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
-  if (ctx.ranks) {
+  if (ctx.ranks && settings_.method == Method::Direct) {
+    const auto t0 = std::chrono::steady_clock::now();
+    stats_ = GravityStats{};
+    stats_.walked = direct_sum_on_ranks(*ctx.ranks, p, Real(settings_.softening), ctx.block_size, ctx.active, field_);
+    stats_.mean_nodes_visited = double(ctx.ranks->global_count() - 1);
+    stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  } else if (ctx.ranks) {
     // The locally essential tree over the global order (essential_tree.hpp):
     // every particle's field is the one-rank group walk's, bit for bit.
     if (const std::string no = distributed_support(); !no.empty())

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # `swirl run` on several MPI ranks (issue 19, points 1, 5, 6 and 7): the same
-# scene (SPH, self-gravity, both; DFSPH and boundary particles; probes,
+# scene (SPH, self-gravity by the tree or the direct sum, both; block time
+# steps; DFSPH and boundary particles; probes,
 # obstacle forces and moving obstacles) on 1 (no mpirun), 2, 3 and 4 ranks
 # gives byte-identical frames, diagnostics, probes.csv and checkpoints; a run resumes on another rank count and ends with the one-rank
 # bytes; a blow-up stops every rank with the one-rank
@@ -151,6 +152,22 @@ on_ranks 2 run --resume "$out/block_resume" --steps 4 --checkpoint-every-steps 4
 for f in particles_000004.vtp diagnostics.csv checkpoints/checkpoint_000000000008.swc; do
   cmp -s "$out/block_1/$f" "$out/block_resume/$f" ||
     fail "block steps resume 3 -> 2 ranks: $f differs from the uninterrupted one-rank run"
+done
+
+# 4a'. The direct sum on ranks (every rank gathers the whole set's positions
+#      and masses): a Plummer sphere of 600 stars, 6 steps, on 3 ranks against
+#      one; and with block time steps on 2.
+direct=("$examples/plummer.toml" --set particles.0.count=600 --set 'nbody.method="direct"' --set output.interval=0.03125)
+for variant in global block; do
+  extra=()
+  [ "$variant" = block ] && extra=(--set 'simulation.time_steps="block"' --set simulation.dt=0.0625
+                                   --set simulation.max_bin=8 --set simulation.eta=0.1)
+  on_ranks 1 run "${direct[@]}" "${extra[@]}" --steps 6 --checkpoint-every-steps 3 --out "$out/direct_${variant}_1"
+  [ "$status" -eq 0 ] || { fail "direct sum ($variant) on 1 rank: status $status"; cat "$out/stderr"; }
+  n=3; [ "$variant" = block ] && n=2
+  on_ranks "$n" run "${direct[@]}" "${extra[@]}" --steps 6 --checkpoint-every-steps 3 --out "$out/direct_${variant}_$n"
+  [ "$status" -eq 0 ] || { fail "direct sum ($variant) on $n ranks: status $status"; cat "$out/stderr"; }
+  same_files "$out/direct_${variant}_1" "$out/direct_${variant}_$n" "the direct sum ($variant steps) on $n ranks"
 done
 
 # 4b. Boundary particles and DFSPH (docs/sph.md): the dam break with an

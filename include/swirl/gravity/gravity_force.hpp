@@ -71,7 +71,8 @@ class GravityForce final : public Solver<Real> {
   // On ranks: each particle's interaction-list length in the last walk.
   void add_rank_costs(std::span<std::uint64_t> costs) const override;
   // Empty when these settings run on several ranks (the linear octree's group
-  // walk, as a view of the order: the locally essential tree); otherwise what does not.
+  // walk, as a view of the order: the locally essential tree; the direct sum,
+  // over the whole set gathered on every rank); otherwise what does not.
   std::string distributed_support() const;
 
   ScanNeeds scan_needs() const override { return {false, !(settings_.softening > 0)}; }
