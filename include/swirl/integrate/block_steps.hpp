@@ -115,7 +115,7 @@ class BlockStepper final : public Stepper<Real> {
             return finest;
           },
           [](std::int32_t x, std::int32_t y) { return std::max(x, y); });
-      finest_ = global_finest(r, finest_);
+      finest_ = over_ranks(r, {finest_, 0}).finest;
     }
     std::uint64_t n = 0;
     while (n < total) {
@@ -145,10 +145,6 @@ class BlockStepper final : public Stepper<Real> {
       std::optional<ScopedPhase> phase;
       if (r.timers) phase.emplace(*r.timers, "integrate");
       bin = bins(p);  // the evaluation may have reordered the particles
-      struct Fold {
-        std::int32_t finest = 0;
-        std::uint64_t active = 0;
-      };
       const Fold fold = parallel::reduce_blocks_pinned(
           "block_kick", p.size(), r.block_size, Fold{},
           [&](std::size_t b, std::size_t e) {
@@ -165,8 +161,9 @@ class BlockStepper final : public Stepper<Real> {
             return f;
           },
           [](Fold x, const Fold& y) { return Fold{std::max(x.finest, y.finest), x.active + y.active}; });
-      finest_ = global_finest(r, fold.finest);
-      active_updates_ += double(r.ranks ? r.ranks->sum(fold.active) : fold.active);
+      const Fold all = over_ranks(r, fold);
+      finest_ = all.finest;
+      active_updates_ += double(all.active);
     }
     ++steps_;
     StepOutcome out;
@@ -207,12 +204,22 @@ class BlockStepper final : public Stepper<Real> {
     return p.int_field(k).data();
   }
 
-  // On several ranks every rank takes the sub-steps of the finest bin of all.
-  static std::int32_t global_finest(const StepRequest& r, std::int32_t mine) {
+  // A pass's finest bin and its count of active particles.
+  struct Fold {
+    std::int32_t finest = 0;
+    std::uint64_t active = 0;
+  };
+  // On several ranks every rank takes the sub-steps of the finest bin of all
+  // and counts every rank's active particles: one all-gather of each rank's
+  // pair packed as active·64 + finest (a bin is at most 40).
+  static Fold over_ranks(const StepRequest& r, const Fold& mine) {
     if (!r.ranks) return mine;
-    double finest[1] = {double(mine)};
-    r.ranks->max(finest);
-    return std::int32_t(finest[0]);
+    Fold all;
+    for (const std::uint64_t packed : r.ranks->all_gather(mine.active * 64 + std::uint64_t(mine.finest))) {
+      all.finest = std::max(all.finest, std::int32_t(packed % 64));
+      all.active += packed / 64;
+    }
+    return all;
   }
 
   // ½·Δt / 2^k, exact in double and rounded once.
