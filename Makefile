@@ -25,8 +25,9 @@ DEB_BUILD_PACKAGES := cmake ninja-build g++ make git pkg-config \
                       libtomlplusplus-dev libcli11-dev libfmt-dev \
                       libxsimd-dev libpng-dev libfreetype-dev fonts-dejavu-core libhdf5-dev \
                       libassimp-dev libboost-dev libboost-system-dev ccache
-# OpenMPI for distributed runs (make mpi; the tests run under mpirun). Not the demo's.
-DEB_MPI_PACKAGES   := libopenmpi-dev openmpi-bin
+# OpenMPI for distributed runs and parallel HDF5 for their frames (make mpi;
+# the tests run under mpirun). Not the demo's.
+DEB_MPI_PACKAGES   := libopenmpi-dev openmpi-bin libhdf5-openmpi-dev
 # python3-venv, python3-dev and python3-numpy: the Python module's venv (make python).
 # chromium and nodejs: the browser test of swirl view's page (tests/browser/; its npm
 # packages come from its lock file, browser-deps).

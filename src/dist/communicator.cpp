@@ -1,6 +1,7 @@
 // The communicator over MPI (SWIRL_WITH_MPI, set by CMake on this file's
 // library when SWIRL_MPI is on) or over a single rank.
 #include "swirl/dist/communicator.hpp"
+#include "mpi_handle.hpp"
 
 #include <cstdlib>
 #include <limits>
@@ -235,6 +236,16 @@ void Communicator::abort(int exit_status) const {
   if (mpi_) MPI_Abort(MPI_COMM_WORLD, exit_status);
 #endif
   std::exit(exit_status);
+}
+
+const void* detail::mpi_comm(const Communicator& comm) {
+#if SWIRL_WITH_MPI
+  static const MPI_Comm world = MPI_COMM_WORLD;  // what world() runs on
+  if (comm.distributed()) return &world;
+#else
+  (void)comm;
+#endif
+  return nullptr;
 }
 
 MpiSession::MpiSession(int& argc, char**& argv) {

@@ -17,6 +17,7 @@
 
 #include "swirl/core/particle_kind.hpp"
 #include "swirl/dist/gather_particles.hpp"
+#include "swirl/dist/snapshot_on_ranks.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/checkpoint.hpp"
 #include "swirl/io/csv.hpp"
@@ -126,60 +127,114 @@ class FrameWriter final : public Observer<Real> {
     std::size_t written = 0;  // frames of this series so far
   };
 
+  // Writes frame frames_. On several ranks HDF5 snapshots are written by every
+  // rank from its own particles (parallel HDF5: io/snapshot.hpp), while the
+  // VTK and CSV files are rank 0's, from the gathered whole set (gathered
+  // only for them).
   void write(Simulation<Real>& sim) {
     ScopedPhase phase(sim.timers(), "output");
-    const ParticleSet<Real>& whole = sim.whole_particles();  // collective on ranks
-    if (!folder_) {  // a rank other than 0: rank 0 writes
-      ++frames_;
-      last_step_ = sim.step_count();
-      return;
+    const dist::Communicator* ranks = sim.ranks() ? &sim.ranks()->comm() : nullptr;
+    const bool gather = !ranks || std::any_of(formats_.begin(), formats_.end(), [](scene::OutputFormat f) {
+      return f != scene::OutputFormat::Hdf5;
+    });
+    Sources sources;
+    if (gather) {
+      sources.whole = &sim.whole_particles();  // collective on ranks; empty on ranks other than 0
+      sources.whole_split = split_by_kind(*sources.whole);
     }
+    sources.own = ranks ? &sim.particles() : sources.whole;
+    if (ranks) sources.own_split = split_by_kind(sim.particles());
+    std::uint64_t boundary = sources.own_kinds().boundary.size();
+    if (ranks) boundary = ranks->sum(boundary);
+
     std::filesystem::path first;
-    const KindSplit split = split_by_kind(whole);  // particle indices of the two series
-    if (split.boundary.empty()) {
-      first = write_frame(particles_, whole, sim.time());
+    if (boundary == 0) {
+      first = write_frame(sim, ranks, particles_, sources, nullptr);
     } else {
-      first = write_frame(particles_, whole.subset(split.rest), sim.time());
+      first = write_frame(sim, ranks, particles_, sources, &KindSplit::rest);
       const auto* moving = sim.moving_boundaries();
       if (boundary_.written == 0 || (moving && !moving->empty()))
-        write_frame(boundary_, whole.subset(split.boundary), sim.time());
+        write_frame(sim, ranks, boundary_, sources, &KindSplit::boundary);
     }
     ++frames_;
     last_step_ = sim.step_count();
+    if (!folder_) return;  // a rank other than 0
     io::RunFolder& folder = *folder_;
     if (on_frame_) on_frame_(first, sim.time(), [&folder](const std::filesystem::path& p) { return folder.claim(p); });
   }
 
-  // Writes `set` as frame frames_ of `series` in every format; returns the
-  // first format's file.
-  std::filesystem::path write_frame(Series& series, const ParticleSet<Real>& set, double time) {
-    io::RunFolder& folder = *folder_;
+  // The particles a frame is written from: this rank's own (its part of an
+  // HDF5 snapshot) and the whole set (rank 0's VTK and CSV files; null when
+  // no format needs it), each with its split by kind. One rank: both the same.
+  struct Sources {
+    const ParticleSet<Real>* own = nullptr;
+    const ParticleSet<Real>* whole = nullptr;
+    KindSplit own_split, whole_split;  // own_split: on ranks only
+    const KindSplit& own_kinds() const { return own == whole ? whole_split : own_split; }
+  };
+
+  // Writes frame frames_ of `series` in every format, of the particles of the
+  // kind `kind` selects (every particle when null); returns rank 0's first
+  // format's file. Collective on ranks.
+  std::filesystem::path write_frame(const Simulation<Real>& sim, const dist::Communicator* ranks, Series& series,
+                                    const Sources& from, std::vector<std::size_t> KindSplit::*kind) {
+    const double time = sim.time();
+    // The rows of a source's set this series holds (nullopt: all of them).
+    const auto rows = [&](const KindSplit& split) -> io::ParticleRows {
+      if (!kind) return std::nullopt;
+      return std::span<const std::size_t>(split.*kind);
+    };
     std::filesystem::path first;
     for (auto format : formats_) {
       std::filesystem::path file;
-      if (format == scene::OutputFormat::Vtp) {
-        const std::string name = io::frame_file_name(series.name, frames_, ".vtp");
-        file = folder.claim(dir_ / name);
-        io::write_vtp(file, set, time);
-        folder.claim(series.pvd.path());
-        series.pvd.add(time, name);
-      } else if (format == scene::OutputFormat::Hdf5) {
+      if (format == scene::OutputFormat::Hdf5) {
         const std::string name = io::frame_file_name(series.name, frames_, ".h5");
-        file = folder.claim(dir_ / name);
+        file = claim_on_every_rank(ranks, dir_ / name);
         io::SnapshotInfo info = snapshot_info_;
         info.time = time;
         info.type = series.type;
-        io::SnapshotLayout layout = io::write_snapshot(file, set, info);
-        folder.claim(series.xdmf.path());
-        series.xdmf.add(name, std::move(layout));
-      } else {
-        file = folder.claim(dir_ / io::frame_file_name(series.name, frames_, ".csv"));
-        io::write_csv(file, set, time);
+        io::SnapshotLayout layout = ranks ? dist::write_snapshot_on_ranks(*ranks, file, *from.own, info, rows(from.own_kinds()))
+                                          : io::write_snapshot(file, *from.own, info, rows(from.own_kinds()));
+        if (folder_) {
+          folder_->claim(series.xdmf.path());
+          series.xdmf.add(name, std::move(layout));
+        }
+      } else if (folder_) {  // rank 0, from the whole set
+        const ParticleSet<Real> subset_copy = kind ? from.whole->subset(from.whole_split.*kind) : ParticleSet<Real>();
+        const ParticleSet<Real>& set = kind ? subset_copy : *from.whole;
+        if (format == scene::OutputFormat::Vtp) {
+          const std::string name = io::frame_file_name(series.name, frames_, ".vtp");
+          file = folder_->claim(dir_ / name);
+          io::write_vtp(file, set, time);
+          folder_->claim(series.pvd.path());
+          series.pvd.add(time, name);
+        } else {
+          file = folder_->claim(dir_ / io::frame_file_name(series.name, frames_, ".csv"));
+          io::write_csv(file, set, time);
+        }
       }
       if (first.empty()) first = file;
     }
     ++series.written;
     return first;
+  }
+
+  // Rank 0 claims `path` in the run folder (it alone keeps the folder); on
+  // ranks every rank learns whether it could, so that a collective write is
+  // started by every rank or by none. Throws IoError on every rank otherwise.
+  std::filesystem::path claim_on_every_rank(const dist::Communicator* ranks, const std::filesystem::path& path) {
+    std::string error;
+    std::filesystem::path claimed = path;
+    if (folder_) {
+      try {
+        claimed = folder_->claim(path);
+      } catch (const io::IoError& e) {
+        error = e.what();
+      }
+    }
+    if (ranks) error = ranks->first_text(error);
+    if (!error.empty()) throw io::IoError(error);
+    return claimed;
   }
 
   bool has(scene::OutputFormat format) const {

@@ -3,7 +3,7 @@
 # scene (SPH, self-gravity by the tree or the direct sum, both; block time
 # steps; DFSPH and boundary particles; probes,
 # obstacle forces and moving obstacles) on 1 (no mpirun), 2, 3 and 4 ranks
-# gives byte-identical frames, diagnostics, probes.csv and checkpoints; a run resumes on another rank count and ends with the one-rank
+# gives byte-identical frames (VTK, and HDF5 written through parallel HDF5), diagnostics, probes.csv and checkpoints; a run resumes on another rank count and ends with the one-rank
 # bytes; a blow-up stops every rank with the one-rank
 # message and keeps the frames; a scene part that is not distributed yet is
 # refused once with status 2 and leaves no folder; more ranks than particles
@@ -28,12 +28,14 @@ on_ranks() {  # on_ranks N ARGS...: swirl on N ranks (1: without mpirun); status
   fi
   status=$?
 }
-# same_files REF DIR WHAT: every frame (the boundary particles' too), the
+# same_files REF DIR WHAT: every frame (the boundary particles' too; VTK and
+# HDF5, the latter written by every rank through parallel HDF5), the
 # diagnostics, probes.csv (when REF has one) and every checkpoint of REF, byte
 # for byte in DIR.
 same_files() {
   local ref=$1 dir=$2 what=$3 f n=0
   for f in "$ref"/particles_*.vtp "$ref"/particles.pvd "$ref"/boundary_*.vtp "$ref"/boundary.pvd \
+           "$ref"/particles_*.h5 "$ref"/particles.xdmf "$ref"/boundary_*.h5 "$ref"/boundary.xdmf \
            "$ref"/diagnostics.csv "$ref"/probes.csv "$ref"/checkpoints/*.swc; do
     [ -e "$f" ] || continue
     n=$((n + 1))
@@ -135,9 +137,10 @@ same_files "$out/drop_1" "$out/drop_3" "SPH with self-gravity on 3 ranks"
 #     of 1 000 stars (its cusp spreads the bins over several levels), dt =
 #     1/16, against one rank as against_one does (2 and 3 ranks, resumed 3 -> 2).
 #     Every sub-step's sort, active groups' essential tree and finest bin are
-#     collective.
-against_one block "block steps" "particles_000015.vtp diagnostics.csv checkpoints/checkpoint_000000000030.swc" \
-  "$examples/hernquist.toml" --set particles.0.count=1000 --set 'simulation.time_steps="block"' \
+#     collective. Frames in HDF5 only: every rank writes its own particles
+#     (nothing is gathered for them).
+against_one block "block steps" "particles_000015.h5 particles.xdmf diagnostics.csv checkpoints/checkpoint_000000000030.swc" \
+  "$examples/hernquist.toml" --set particles.0.count=1000 --set 'simulation.time_steps="block"' --set 'output.format="hdf5"' \
   --set simulation.dt=0.0625 --set simulation.max_bin=12 --set simulation.eta=0.2 --set output.interval=0.125
 
 # 4a'. The direct sum on ranks (every rank gathers the whole set's positions
@@ -198,10 +201,12 @@ awk -F, 'NR > 1 && $2 != 0 && $3 != 0 && $4 != 0 { ok = 1 } END { exit !ok }' "$
 #     lines, the tank's force and torque about its moving centre), on 2 and 3
 #     ranks against one, and resumed 3 -> 2. The tank's particles cross the
 #     cuts as it rolls: the density solve's recorded reactions follow them.
+#     Frames in VTK (rank 0, gathered) and HDF5 (every rank, its own water and
+#     tank particles in their two series).
 slosh=("$examples/sloshing.toml" --set particles.1.motion.ramp=0 --set particles.1.motion.amplitude_deg=8
-       --set particles.1.motion.frequency=2 --set output.interval=0.05)
+       --set particles.1.motion.frequency=2 --set output.interval=0.05 --set 'output.format=["vtp", "hdf5"]')
 against_one moving "a moving obstacle with probes" \
-  "particles_000001.vtp boundary_000001.vtp boundary.pvd diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc" \
+  "particles_000001.vtp particles_000001.h5 boundary_000001.vtp boundary_000001.h5 boundary.xdmf diagnostics.csv probes.csv checkpoints/checkpoint_000000000030.swc" \
   "${slosh[@]}"
 
 # 5. A blow-up (a step far beyond the CFL limit) on 3 ranks: status 1, the

@@ -98,6 +98,20 @@ TYPED_TEST(SnapshotTest, TheSameStateGivesTheSameBytesAndNbodyUnitsAreSaid) {
   EXPECT_NE(test::slurp(dir / "a.h5"), test::slurp(dir / "c.h5"));
 }
 
+TYPED_TEST(SnapshotTest, ASelectionOfRowsWritesTheSubsetsBytes) {
+  using Real = TypeParam;
+  TempDir dir;
+  const auto p = test::make_particles<Real>(500);
+  const std::vector<std::size_t> rows{3, 4, 17, 250, 499};
+  write_snapshot(dir / "rows.h5", p, SnapshotInfo{}, std::span<const std::size_t>(rows));
+  write_snapshot(dir / "subset.h5", p.subset(rows), SnapshotInfo{});
+  EXPECT_EQ(test::slurp(dir / "rows.h5"), test::slurp(dir / "subset.h5"));
+  EXPECT_EQ(read_snapshot(dir / "rows.h5").ids, (std::vector<std::uint64_t>{p.id[3], p.id[4], p.id[17], p.id[250], p.id[499]}));
+  const std::vector<std::size_t> beyond{2, 500};
+  EXPECT_THROW(write_snapshot(dir / "bad.h5", p, SnapshotInfo{}, std::span<const std::size_t>(beyond)), std::out_of_range);
+  EXPECT_FALSE(std::filesystem::exists(dir / "bad.h5"));
+}
+
 TYPED_TEST(SnapshotTest, NoParticlesIsAValidSnapshot) {
   using Real = TypeParam;
   TempDir dir;

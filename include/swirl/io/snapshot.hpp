@@ -27,8 +27,10 @@
 //                          potential, by their own names), real fields in the
 //                          run's precision, integer fields as int32; each with
 //                          an attribute "units" naming its unit in words.
-// Datasets are chunked and deflated (with the shuffle filter); object times are
-// not recorded, so the same state gives the same bytes.
+// Datasets are chunked (65 536 rows a chunk) and deflated (with the shuffle
+// filter), their chunks allocated when they are created; object times are not
+// recorded, so the same state gives the same bytes, written by one process or
+// by the ranks of a run (parallel HDF5).
 //
 // Reading accepts any file with that layout (masses either per particle or
 // from MassTable) and refuses anything else with an IoError naming the file
@@ -46,6 +48,7 @@
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -85,16 +88,47 @@ struct SnapshotLayout {
   std::vector<Dataset> datasets;  // in file order: Coordinates, Velocities, Masses, ParticleIDs, ...
 };
 
+// Which particles of a set a file holds: the set's indices `rows`, in that
+// order (a frame series of one particle kind); nullopt: all, in memory order.
+using ParticleRows = std::optional<std::span<const std::size_t>>;
+
 // Writes one frame atomically (built in memory, then io::write_file_atomic)
 // and returns what it wrote.
 template <class Real>
 SnapshotLayout write_snapshot(const std::filesystem::path& path, const ParticleSet<Real>& particles,
-                              const SnapshotInfo& info);
+                              const SnapshotInfo& info, ParticleRows rows = std::nullopt);
+
+// One process's part of a snapshot that several write together (parallel
+// HDF5's MPI-IO driver; builds with MPI only: SWIRL_PARALLEL_HDF5). Every
+// process of the communicator calls write_snapshot_part() with the same
+// `file`, `total` and info (collective), each its own rows, which are rows
+// [first, first + its count) of the file; the file holds the bytes
+// write_snapshot() gives for the whole set on one process (every dataset's
+// chunks are allocated when it is created, as parallel HDF5 requires, in
+// both). The caller names the file, makes it public (a temporary file renamed
+// once every process has returned) and agrees on failures:
+// dist::write_snapshot_on_ranks() does all that. Throws IoError naming
+// `path_in_messages` on the process that failed.
+struct SnapshotPart {
+  const void* mpi_comm = nullptr;  // points to an MPI_Comm (dist: src/dist/mpi_handle.hpp)
+  std::filesystem::path file;      // where they write
+  std::uint64_t first = 0, total = 0;
+};
+
+template <class Real>
+SnapshotLayout write_snapshot_part(const SnapshotPart& part, const std::filesystem::path& path_in_messages,
+                                   const ParticleSet<Real>& particles, const SnapshotInfo& info,
+                                   ParticleRows rows = std::nullopt);
 
 extern template SnapshotLayout write_snapshot<float>(const std::filesystem::path&, const ParticleSet<float>&,
-                                                     const SnapshotInfo&);
+                                                     const SnapshotInfo&, ParticleRows);
 extern template SnapshotLayout write_snapshot<double>(const std::filesystem::path&, const ParticleSet<double>&,
-                                                      const SnapshotInfo&);
+                                                      const SnapshotInfo&, ParticleRows);
+extern template SnapshotLayout write_snapshot_part<float>(const SnapshotPart&, const std::filesystem::path&,
+                                                          const ParticleSet<float>&, const SnapshotInfo&, ParticleRows);
+extern template SnapshotLayout write_snapshot_part<double>(const SnapshotPart&, const std::filesystem::path&,
+                                                           const ParticleSet<double>&, const SnapshotInfo&,
+                                                           ParticleRows);
 
 // The layout of a snapshot file, from its header and dataset shapes only (no
 // values read), for the particle type asked for or as read_snapshot chooses.
