@@ -128,7 +128,7 @@ class FrameWriter final : public Observer<Real> {
   };
 
   // Writes frame frames_. On several ranks HDF5 snapshots are written by every
-  // rank from its own particles (parallel HDF5: io/snapshot.hpp), while the
+  // rank from its own particles (parallel HDF5: dist/snapshot_on_ranks.hpp), while the
   // VTK and CSV files are rank 0's, from the gathered whole set (gathered
   // only for them).
   void write(Simulation<Real>& sim) {
@@ -193,8 +193,9 @@ class FrameWriter final : public Observer<Real> {
         io::SnapshotInfo info = snapshot_info_;
         info.time = time;
         info.type = series.type;
-        io::SnapshotLayout layout = ranks ? dist::write_snapshot_on_ranks(*ranks, file, *from.own, info, rows(from.own_kinds()))
-                                          : io::write_snapshot(file, *from.own, info, rows(from.own_kinds()));
+        const io::ParticleRows own_rows = rows(from.own_kinds());
+        io::SnapshotLayout layout = ranks ? dist::write_snapshot_on_ranks(*ranks, file, *from.own, info, own_rows)
+                                          : io::write_snapshot(file, *from.own, info, own_rows);
         if (folder_) {
           folder_->claim(series.xdmf.path());
           series.xdmf.add(name, std::move(layout));
@@ -342,14 +343,19 @@ class DiagnosticsLog final : public Observer<Real> {
  private:
   void add_row(Simulation<Real>& sim) {
     ScopedPhase phase(sim.timers(), "output");
-    const auto& p = sim.whole_particles();  // collective on ranks
+    // Every rank's own particles, reduced in the one-rank block order
+    // (dist::BlockFold): collective on ranks, no gather.
+    const auto& p = sim.particles();
+    dist::BlockFold fold = dist::BlockFold::one_rank(block_size_);
+    if (const auto* ranks = sim.ranks()) fold.ranks = &ranks->comm(), fold.first = ranks->first_global_index();
+    const Mechanics m = mechanics(p, fold);
+    const double potential = potential_energy(sim, p, fold);
+    const auto columns = diagnostic_values(sim, p, fold);
     if (!folder_) {  // a rank other than 0: rank 0 writes, and checks the energy
       ++rows_;
       last_step_ = sim.step_count();
       return;
     }
-    const Mechanics m = mechanics(p, block_size_);
-    const double potential = potential_energy(sim, p, block_size_);
     const double total = m.kinetic + potential;
     std::vector<double> row{sim.time(), m.kinetic, potential, total};
     if (conservative_) {
@@ -358,7 +364,7 @@ class DiagnosticsLog final : public Observer<Real> {
       row.push_back(energy_error_);
     }
     row.insert(row.end(), {m.momentum[0], m.momentum[1], m.momentum[2], m.angular[0], m.angular[1], m.angular[2]});
-    for (const auto& column : diagnostic_values(sim, p, block_size_)) row.push_back(column.second);
+    for (const auto& column : columns) row.push_back(column.second);
     for (std::size_t k = 0; k < row.size(); ++k) text_ += fmt::format("{}{:.9g}", k ? "," : "", row[k]);
     if (adaptive_) {
       const bool stepped = frame_dt_max_ > 0;

@@ -249,11 +249,11 @@ TEST(BoundaryVolumes, TheDiagnosticsAreTheFluids) {
     error_sum += e, error_max = std::max(error_max, e);
   }
   double potential = 0;
-  for (const auto& s : sim.solvers()) potential += s->potential_energy(p, 64);
+  for (const auto& s : sim.solvers()) potential += s->potential_energy(p, dist::BlockFold::one_rank(64));
   EXPECT_NEAR(potential, fluid_potential, 1e-12 * fluid_potential);
   const auto& sph = *sim.find_solver<sph::SphFluid<double>>();
   std::vector<double> row;
-  sph.add_diagnostics(p, 64, row);
+  sph.add_diagnostics(p, dist::BlockFold::one_rank(64), row);
   ASSERT_GE(row.size(), 2u);
   EXPECT_NEAR(row[0], error_sum / double(fluid), 1e-12);
   EXPECT_EQ(row[1], error_max);

@@ -39,6 +39,7 @@
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/phase_timers.hpp"
+#include "swirl/dist/block_fold.hpp"
 #include "swirl/dist/communicator.hpp"
 #include "swirl/force/step_scan.hpp"
 #include "swirl/spatial/particle_order.hpp"
@@ -119,12 +120,17 @@ class Solver {
   // What to change when the state blows up, e.g. "for close encounters, a larger softening".
   virtual std::string advice() const { return {}; }
 
-  // Diagnostics: the solver's columns of the per-frame log and their values.
+  // Diagnostics: the solver's columns of the per-frame log and their values,
+  // over `particles` (this rank's own; on one rank the whole set), whose
+  // place in the one-rank order `fold` says: sums and maxima over them go
+  // through fold (dist/block_fold.hpp), so the values have the one-rank bits
+  // on any rank count. Collective on ranks: every rank calls, every rank gets
+  // the values.
   virtual std::vector<std::string> diagnostic_columns() const { return {}; }
-  virtual void add_diagnostics(const ParticleSet<Real>& /*particles*/, std::size_t /*block_size*/,
+  virtual void add_diagnostics(const ParticleSet<Real>& /*particles*/, const dist::BlockFold& /*fold*/,
                                std::vector<double>& /*row*/) const {}
-  // Its potential energy in the current state (0 for forces without one).
-  virtual double potential_energy(const ParticleSet<Real>& /*particles*/, std::size_t /*block_size*/) const {
+  // Its potential energy in the current state (0 for forces without one), the same way.
+  virtual double potential_energy(const ParticleSet<Real>& /*particles*/, const dist::BlockFold& /*fold*/) const {
     return 0;
   }
   // False when the solver dissipates or stores energy the log does not count

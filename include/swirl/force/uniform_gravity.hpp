@@ -38,22 +38,19 @@ class UniformGravity final : public Solver<Real> {
     });
   }
 
-  // Summed in double per block and folded in block order: the same bits for any thread count.
-  double potential_energy(const ParticleSet<Real>& p, std::size_t block_size) const override {
+  // U = −Σ m g·x over the fluid, summed in double in the one-rank block order
+  // (dist::BlockFold): the same bits for any thread and rank count.
+  double potential_energy(const ParticleSet<Real>& p, const dist::BlockFold& fold) const override {
     const Vec3d g = g_.template cast<double>();
     const std::size_t k = p.find_int_field(kKindField);
     const std::int32_t* kind = k == ParticleSet<Real>::npos ? nullptr : p.int_field(k).data();
-    return parallel::reduce_blocks(
-        "uniform_gravity_energy", p.size(), block_size, 0.0,
-        [&](std::size_t b, std::size_t e) {
-          double u = 0;
-          for (std::size_t i = b; i < e; ++i)
-            if (!kind || !is_boundary(kind[i]))
-              u -= double(p.mass[i]) * (g.x * double(p.position.x[i]) + g.y * double(p.position.y[i]) +
-                                      g.z * double(p.position.z[i]));
-          return u;
-        },
-        [](double a, double b) { return a + b; });
+    return fold("uniform_gravity_energy", p.size(), std::array{dist::FoldOp::Sum},
+                [&](std::size_t i, std::array<double, 1>& u) {
+                  if (kind && is_boundary(kind[i])) return false;
+                  u[0] = -(double(p.mass[i]) * (g.x * double(p.position.x[i]) + g.y * double(p.position.y[i]) +
+                                                g.z * double(p.position.z[i])));
+                  return true;
+                })[0];
   }
 
   const Vec3<Real>& g() const { return g_; }

@@ -81,9 +81,9 @@ class GravityForce final : public Solver<Real> {
   std::string advice() const override { return "for close encounters, a larger softening"; }
 
   std::vector<std::string> diagnostic_columns() const override { return {"virial_ratio", "mean_nodes_visited"}; }
-  void add_diagnostics(const ParticleSet<Real>& particles, std::size_t block_size,
+  void add_diagnostics(const ParticleSet<Real>& particles, const dist::BlockFold& fold,
                        std::vector<double>& row) const override;
-  double potential_energy(const ParticleSet<Real>& particles, std::size_t block_size) const override;
+  double potential_energy(const ParticleSet<Real>& particles, const dist::BlockFold& fold) const override;
   void add_metrics(NamedValues& out) const override;
   void add_rank_metrics(NamedValues& out) const override;
   std::size_t scratch_bytes() const override { return stats_.tree_bytes; }

@@ -490,27 +490,23 @@ class SphFluid final : public Solver<Real> {
   std::vector<std::string> diagnostic_columns() const override {
     return {"mean_density_error", "max_density_error", "mean_neighbours"};
   }
-  // Mean and largest |ρ − ρ0|/ρ0 (block-order sums: the same bits for any
-  // thread count), and the last evaluation's mean neighbour count.
-  void add_diagnostics(const ParticleSet<Real>& p, std::size_t block_size, std::vector<double>& row) const override {
-    using Partial = std::array<double, 2>;
+  // Mean and largest |ρ − ρ0|/ρ0 over the fluid (in the one-rank block
+  // order: the same bits for any thread and rank count), and the last
+  // evaluation's mean neighbour count.
+  void add_diagnostics(const ParticleSet<Real>& p, const dist::BlockFold& fold,
+                       std::vector<double>& row) const override {
+    using dist::FoldOp;
     const double rho0 = params_.rest_density;
     const std::int32_t* kind = kinds(p);
-    const std::size_t fluid = kind ? count_fluid(p) : p.size();
-    const Partial e = parallel::reduce_blocks(
-        "sph_diagnostics", p.size(), block_size, Partial{},
-        [&](std::size_t b, std::size_t end) {
-          Partial s{};
-          for (std::size_t i = b; i < end; ++i) {
-            if (kind && is_boundary(kind[i])) continue;  // the fluid's error only
-            const double error = std::abs(double(p.density[i]) - rho0) / rho0;
-            s[0] += error;
-            s[1] = std::max(s[1], error);
-          }
-          return s;
-        },
-        [](Partial a, const Partial& b) { return Partial{a[0] + b[0], std::max(a[1], b[1])}; });
-    row.insert(row.end(), {fluid == 0 ? 0.0 : e[0] / double(fluid), e[1], mean_neighbours_});
+    // The error's sum and maximum, and the fluid particles counted.
+    const auto e = fold("sph_diagnostics", p.size(), std::array{FoldOp::Sum, FoldOp::Max, FoldOp::Sum},
+                        [&](std::size_t i, std::array<double, 3>& c) {
+                          if (kind && is_boundary(kind[i])) return false;  // the fluid's error only
+                          const double error = std::abs(double(p.density[i]) - rho0) / rho0;
+                          c = {error, error, 1.0};
+                          return true;
+                        });
+    row.insert(row.end(), {e[2] == 0 ? 0.0 : e[0] / e[2], e[1], mean_neighbours_});
   }
   // Viscosity dissipates, and the equation of state's elastic energy is not counted.
   bool conserves_energy() const override { return false; }
