@@ -15,6 +15,7 @@
 #include <random>
 #include <vector>
 
+#include "dist/block_cuts.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::dist {
@@ -60,17 +61,8 @@ TEST(BlockFold, IsTheOneRankBlockFoldForAnyCuts) {
       for (std::size_t i = 0; i < n; ++i)
         if (contributes(i)) plain += v[i];
       if (plain != want[0]) ++order_matters;
-      for (int pattern = 0; pattern < 4; ++pattern) {
-        std::vector<std::size_t> start(ranks + 1, n);
-        for (std::size_t k = 0; k < ranks; ++k) {
-          switch (pattern) {
-            case 0: start[k] = n * k / ranks; break;
-            case 1: start[k] = k == 0 ? 0 : n; break;
-            case 2: start[k] = std::min(n, (n * k / ranks) / bs * bs); break;
-            default: start[k] = std::min(n, k == 0 ? 0 : bs / 2 + 2 * k); break;
-          }
-        }
-        for (std::size_t k = 1; k <= ranks; ++k) start[k] = std::max(start[k], start[k - 1]);
+      for (int pattern = 0; pattern < test::kBlockCutPatterns; ++pattern) {
+        const std::vector<std::size_t> start = test::block_cut_starts(n, ranks, bs, pattern);
         const BlockFold fold{&comm, start[r], bs};
         const auto got = fold("test", start[r + 1] - start[r], kOps, [&](std::size_t i, std::array<double, 3>& c) {
           const std::size_t g = start[r] + i;

@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "dist/block_cuts.hpp"
 #include "swirl/parallel/for_blocks.hpp"
 
 namespace swirl::dist {
@@ -49,19 +50,10 @@ TEST(BlockOrderedSum, IsTheOneRankBlockSumForAnyCuts) {
       double plain = 0;
       for (const double x : v) plain += x;
       if (plain != want) ++order_matters;
-      // Cut patterns: even shares; everything on the last rank; block-aligned
-      // cuts; a rank with a few particles in the middle of a block.
-      for (int pattern = 0; pattern < 4; ++pattern) {
-        std::vector<std::size_t> start(ranks + 1, n);
-        for (std::size_t k = 0; k < ranks; ++k) {
-          switch (pattern) {
-            case 0: start[k] = n * k / ranks; break;
-            case 1: start[k] = k == 0 ? 0 : n; break;
-            case 2: start[k] = std::min(n, (n * k / ranks) / bs * bs); break;
-            default: start[k] = std::min(n, k == 0 ? 0 : bs / 2 + 2 * k); break;
-          }
-        }
-        for (std::size_t k = 1; k <= ranks; ++k) start[k] = std::max(start[k], start[k - 1]);
+      // Cut patterns (block_cuts.hpp): even shares; everything on one rank;
+      // block-aligned cuts; ranks of a few particles inside a block.
+      for (int pattern = 0; pattern < test::kBlockCutPatterns; ++pattern) {
+        const std::vector<std::size_t> start = test::block_cut_starts(n, ranks, bs, pattern);
         const std::span<const double> mine(v.data() + start[r], start[r + 1] - start[r]);
         const double got = block_ordered_sum(comm, start[r], mine, bs);
         EXPECT_EQ(std::bit_cast<std::uint64_t>(got), std::bit_cast<std::uint64_t>(want))
