@@ -1,6 +1,7 @@
 #include "swirl/dist/snapshot_on_ranks.hpp"
 
 #include <string>
+#include <vector>
 #include <system_error>
 
 #include "mpi_handle.hpp"
@@ -16,8 +17,11 @@ io::SnapshotLayout write_snapshot_on_ranks(const Communicator& comm, const std::
   const std::uint64_t mine = rows ? rows->size() : own.size();
   io::SnapshotPart part;
   part.mpi_comm = detail::mpi_comm(comm);
-  part.first = comm.exclusive_prefix_sum(mine);
-  part.total = comm.sum(mine);
+  const std::vector<std::uint64_t> counts = comm.all_gather(mine);  // every rank's rows: one collective
+  for (int r = 0; r < comm.size(); ++r) {
+    if (r < comm.rank()) part.first += counts[std::size_t(r)];
+    part.total += counts[std::size_t(r)];
+  }
   std::string error;
   if (comm.is_root()) {
     try {

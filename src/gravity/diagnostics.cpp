@@ -1,5 +1,6 @@
 #include "swirl/gravity/diagnostics.hpp"
 
+#include <array>
 #include <cmath>
 #include <stdexcept>
 
@@ -65,21 +66,31 @@ Diagnostics diagnose(const ParticleSet<Real>& p, std::size_t block_size) {
 }
 
 template <class Real>
-double potential_energy(const ParticleSet<Real>& p, std::size_t block_size) {
+double potential_energy(const ParticleSet<Real>& p, const dist::BlockFold& fold) {
   const Real* phi = potential_field(p);
-  return parallel::reduce_blocks(
-      "gravity_potential_energy", p.size(), block_size, 0.0,
-      [&](std::size_t b, std::size_t e) {
-        double w = 0;
-        for (std::size_t i = b; i < e; ++i) w += 0.5 * double(p.mass[i]) * double(phi[i]);  // W = ½ Σ m φ
-        return w;
-      },
-      [](double a, double b) { return a + b; });
+  return fold.sum("gravity_potential_energy", p.size(),
+                  [&](std::size_t i) { return 0.5 * double(p.mass[i]) * double(phi[i]); });  // W = ½ Σ m φ
+}
+
+template <class Real>
+double virial_ratio(const ParticleSet<Real>& p, const dist::BlockFold& fold) {
+  const Real* phi = potential_field(p);
+  const auto kw = fold("gravity_virial", p.size(), std::array{dist::FoldOp::Sum, dist::FoldOp::Sum},
+                       [&](std::size_t i, std::array<double, 2>& c) {
+                         const double m = p.mass[i];
+                         const Vec3d v = p.velocity.get(i).template cast<double>();
+                         c[0] = 0.5 * m * dot(v, v);     // K
+                         c[1] = 0.5 * m * double(phi[i]);  // W
+                         return true;
+                       });
+  return kw[1] != 0 ? 2 * kw[0] / std::abs(kw[1]) : 0.0;
 }
 
 template Diagnostics diagnose<float>(const ParticleSet<float>&, std::size_t);
 template Diagnostics diagnose<double>(const ParticleSet<double>&, std::size_t);
-template double potential_energy<float>(const ParticleSet<float>&, std::size_t);
-template double potential_energy<double>(const ParticleSet<double>&, std::size_t);
+template double potential_energy<float>(const ParticleSet<float>&, const dist::BlockFold&);
+template double potential_energy<double>(const ParticleSet<double>&, const dist::BlockFold&);
+template double virial_ratio<float>(const ParticleSet<float>&, const dist::BlockFold&);
+template double virial_ratio<double>(const ParticleSet<double>&, const dist::BlockFold&);
 
 }  // namespace swirl::gravity

@@ -277,39 +277,15 @@ LimitText GravityForce<Real>::explain(const StepLimit& l, std::string_view id) c
           "or a larger softening ε"};
 }
 
-namespace {
-// The "potential" field GravityForce writes (evaluate it first).
-template <class Real>
-const Real* potential_of(const ParticleSet<Real>& p) {
-  const std::size_t k = p.find_field("potential");
-  if (k == ParticleSet<Real>::npos)
-    throw std::invalid_argument("gravity diagnostics: the particles have no \"potential\" field; evaluate the gravity "
-                                "force first");
-  return p.extra(k).data();
-}
-}  // namespace
-
 template <class Real>
 void GravityForce<Real>::add_diagnostics(const ParticleSet<Real>& p, const dist::BlockFold& fold,
                                          std::vector<double>& row) const {
-  // The virial ratio 2K/|W| (gravity/diagnostics.hpp), K and W in the one-rank block order.
-  const Real* phi = potential_of(p);
-  const auto kw = fold("gravity_virial", p.size(), std::array{dist::FoldOp::Sum, dist::FoldOp::Sum},
-                       [&](std::size_t i, std::array<double, 2>& c) {
-                         const double m = p.mass[i];
-                         const Vec3d v = p.velocity.get(i).template cast<double>();
-                         c[0] = 0.5 * m * dot(v, v);
-                         c[1] = 0.5 * m * double(phi[i]);
-                         return true;
-                       });
-  row.insert(row.end(), {kw[1] != 0 ? 2 * kw[0] / std::abs(kw[1]) : 0.0, stats_.mean_nodes_visited});
+  row.insert(row.end(), {virial_ratio(p, fold), stats_.mean_nodes_visited});
 }
 
 template <class Real>
 double GravityForce<Real>::potential_energy(const ParticleSet<Real>& p, const dist::BlockFold& fold) const {
-  const Real* phi = potential_of(p);
-  return fold.sum("gravity_potential_energy", p.size(),
-                  [&](std::size_t i) { return 0.5 * double(p.mass[i]) * double(phi[i]); });  // W = ½ Σ m φ
+  return gravity::potential_energy(p, fold);
 }
 
 template <class Real>

@@ -45,7 +45,6 @@ class TempFile {
   }
 
   int open() { return fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666); }
-  int open_existing() { return fd_ = ::open(path_.c_str(), O_WRONLY | O_CLOEXEC); }
   int close() {
     int fd = fd_;
     fd_ = -1;  // close() releases the descriptor even when it reports an error
@@ -107,16 +106,10 @@ fs::path temporary_sibling(const fs::path& path) {
   return unique_sibling(path, "tmp");
 }
 
-void publish_file_atomic(const fs::path& temporary, const fs::path& path, bool sync) {
-  TempFile tmp(temporary);  // removed on every early exit
-  if (sync) {
-    if (tmp.open_existing() < 0) fail(path, fmt::format("cannot open the written file {}", temporary.string()), errno);
-    if (::fsync(tmp.fd()) != 0) fail(path, "fsync failed", errno);
-    if (tmp.close() != 0) fail(path, "close failed", errno);
-  }
+void publish_file_atomic(const fs::path& temporary, const fs::path& path) {
+  TempFile tmp(temporary);  // removed if the rename fails
   if (::rename(temporary.c_str(), path.c_str()) != 0) fail(path, "cannot rename the temporary file over it", errno);
   tmp.release();
-  if (sync) sync_directory(path);
 }
 
 void ensure_writable_directory(const fs::path& dir, std::uintmax_t bytes_needed) {

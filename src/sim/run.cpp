@@ -185,6 +185,7 @@ class FrameWriter final : public Observer<Real> {
       return std::span<const std::size_t>(split.*kind);
     };
     std::filesystem::path first;
+    std::optional<ParticleSet<Real>> subset;  // the VTK and CSV files' copy of this series' particles
     for (auto format : formats_) {
       std::filesystem::path file;
       if (format == scene::OutputFormat::Hdf5) {
@@ -200,9 +201,9 @@ class FrameWriter final : public Observer<Real> {
           folder_->claim(series.xdmf.path());
           series.xdmf.add(name, std::move(layout));
         }
-      } else if (folder_) {  // rank 0, from the whole set
-        const ParticleSet<Real> subset_copy = kind ? from.whole->subset(from.whole_split.*kind) : ParticleSet<Real>();
-        const ParticleSet<Real>& set = kind ? subset_copy : *from.whole;
+      } else if (folder_) {  // rank 0, from the whole set (this series' particles copied once)
+        if (kind && !subset) subset = from.whole->subset(from.whole_split.*kind);
+        const ParticleSet<Real>& set = kind ? *subset : *from.whole;
         if (format == scene::OutputFormat::Vtp) {
           const std::string name = io::frame_file_name(series.name, frames_, ".vtp");
           file = folder_->claim(dir_ / name);

@@ -1,15 +1,30 @@
-// The cuts of a global order of n particles into ranks that the block-order
-// reduction tests (block_sum_test.cpp, block_fold_test.cpp) try: rank k holds
-// [start[k], start[k+1]). Pattern 0: even shares; 1: everything on rank 0,
-// the others empty; 2: cuts on block starts (block size bs); 3: ranks of a
-// few particles each inside the first blocks. kBlockCutPatterns of them.
+// What the block-order reduction tests (block_sum_test.cpp,
+// block_fold_test.cpp) reduce and how they cut it into ranks.
+//
+// order_sensitive_values: n values over 20 orders of magnitude with both
+// signs, so that a sum in another order gives other bits.
+// block_cut_starts: rank k holds [start[k], start[k+1]) of n particles.
+// Pattern 0: even shares; 1: everything on rank 0, the others empty; 2: cuts
+// on block starts (block size bs); 3: ranks of a few particles each inside
+// the first blocks. kBlockCutPatterns of them.
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <random>
 #include <vector>
 
 namespace swirl::dist::test {
+
+inline std::vector<double> order_sensitive_values(std::size_t n, std::uint64_t seed) {
+  std::mt19937_64 rng(seed + n);
+  std::uniform_real_distribution<double> mantissa(-1, 1), exponent(-10, 10);
+  std::vector<double> v(n);
+  for (double& x : v) x = mantissa(rng) * std::pow(10.0, exponent(rng));
+  return v;
+}
 
 inline constexpr int kBlockCutPatterns = 4;
 

@@ -12,7 +12,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <random>
 #include <vector>
 
 #include "dist/block_cuts.hpp"
@@ -21,14 +20,7 @@
 namespace swirl::dist {
 namespace {
 
-// Values over 20 orders of magnitude with both signs: a reordered sum differs.
-std::vector<double> values_for(std::size_t n) {
-  std::mt19937_64 rng(777 + n);
-  std::uniform_real_distribution<double> mantissa(-1, 1), exponent(-10, 10);
-  std::vector<double> v(n);
-  for (double& x : v) x = mantissa(rng) * std::pow(10.0, exponent(rng));
-  return v;
-}
+std::vector<double> values_for(std::size_t n) { return test::order_sensitive_values(n, 777); }
 
 constexpr std::array<FoldOp, 3> kOps{FoldOp::Sum, FoldOp::Max, FoldOp::Sum};
 

@@ -7,9 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
-#include <cmath>
 #include <cstdint>
-#include <random>
 #include <vector>
 
 #include "dist/block_cuts.hpp"
@@ -18,14 +16,7 @@
 namespace swirl::dist {
 namespace {
 
-// Values over 20 orders of magnitude with both signs: a reordered sum differs.
-std::vector<double> values_for(std::size_t n) {
-  std::mt19937_64 rng(12345 + n);
-  std::uniform_real_distribution<double> mantissa(-1, 1), exponent(-10, 10);
-  std::vector<double> v(n);
-  for (double& x : v) x = mantissa(rng) * std::pow(10.0, exponent(rng));
-  return v;
-}
+std::vector<double> values_for(std::size_t n) { return test::order_sensitive_values(n, 12345); }
 
 double one_rank_sum(const std::vector<double>& v, std::size_t block_size) {
   return parallel::reduce_blocks(

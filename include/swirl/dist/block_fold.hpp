@@ -11,10 +11,10 @@
 //   combine(a, b) = op_j(a_j, b_j) per component,
 // with op_j either a + b or std::max(a, b). On ranks, rank r holds the range
 // [first_r, first_r + n_r) of the one-rank order, and a block [kB, (k+1)B)
-// may be cut by rank boundaries. As dist::block_ordered_sum does for one sum,
-// each rank sends (one all-gather) its head — the contributions, raw, of its
-// particles in the block that began on an earlier rank — and the partial of
-// every block that begins on it, over its own part; every rank then folds the
+// may be cut by rank boundaries. Each rank sends (one all-gather) its head —
+// the contributions, raw, of its particles in the block that began on an
+// earlier rank — and the partial of every block that begins on it, over its
+// own part; every rank then folds the
 // records in rank order: a head's contributions continue the open block's
 // fold exactly as the one-rank block function would, a block start closes the
 // open block into the total. The same bits for any rank and thread count.

@@ -13,6 +13,7 @@
 
 #include "swirl/core/particle_set.hpp"
 #include "swirl/core/vec3.hpp"
+#include "swirl/dist/block_fold.hpp"
 
 namespace swirl::gravity {
 
@@ -31,13 +32,25 @@ struct Diagnostics {
 template <class Real>
 Diagnostics diagnose(const ParticleSet<Real>& p, std::size_t block_size = 1024);
 
-// W = ½ Σ m_i φ_i from the "potential" field (same exception as diagnose()).
+// W = ½ Σ m_i φ_i from the "potential" field (same exception as diagnose()),
+// and the virial ratio 2K/|W| (0 if W = 0), over this rank's particles in the
+// one-rank block order (dist/block_fold.hpp: collective on ranks, the same
+// bits on any rank count): GravityForce's diagnostics.csv columns.
 template <class Real>
-double potential_energy(const ParticleSet<Real>& p, std::size_t block_size = 1024);
+double potential_energy(const ParticleSet<Real>& p, const dist::BlockFold& fold);
+template <class Real>
+double virial_ratio(const ParticleSet<Real>& p, const dist::BlockFold& fold);
+// W of the whole set on one rank.
+template <class Real>
+double potential_energy(const ParticleSet<Real>& p, std::size_t block_size = 1024) {
+  return potential_energy(p, dist::BlockFold::one_rank(block_size));
+}
 
 extern template Diagnostics diagnose<float>(const ParticleSet<float>&, std::size_t);
 extern template Diagnostics diagnose<double>(const ParticleSet<double>&, std::size_t);
-extern template double potential_energy<float>(const ParticleSet<float>&, std::size_t);
-extern template double potential_energy<double>(const ParticleSet<double>&, std::size_t);
+extern template double potential_energy<float>(const ParticleSet<float>&, const dist::BlockFold&);
+extern template double potential_energy<double>(const ParticleSet<double>&, const dist::BlockFold&);
+extern template double virial_ratio<float>(const ParticleSet<float>&, const dist::BlockFold&);
+extern template double virial_ratio<double>(const ParticleSet<double>&, const dist::BlockFold&);
 
 }  // namespace swirl::gravity

@@ -24,13 +24,13 @@ class IoError : public std::runtime_error {
 void write_file_atomic(const std::filesystem::path& path, std::string_view bytes, bool sync = false);
 
 // The same for a file that something else fills (the ranks of a parallel
-// HDF5 write, io/snapshot.hpp): temporary_sibling() names a temporary file
-// beside `path`, unique to this process; once it is complete,
-// publish_file_atomic() renames it over `path` (with `sync`, fsync'ing it
-// before and the directory after). On failure the temporary file is removed,
-// `path` is untouched and IoError is thrown.
+// HDF5 write, dist/snapshot_on_ranks.hpp): temporary_sibling() names a
+// temporary file beside `path`, unique to this process; once it is complete,
+// publish_file_atomic() renames it over `path` (not synced: frames are not).
+// On failure the temporary file is removed, `path` is untouched and IoError
+// is thrown.
 std::filesystem::path temporary_sibling(const std::filesystem::path& path);
-void publish_file_atomic(const std::filesystem::path& temporary, const std::filesystem::path& path, bool sync = false);
+void publish_file_atomic(const std::filesystem::path& temporary, const std::filesystem::path& path);
 
 // The whole content of a file (io::read_regular_file: a regular file of at
 // most max_bytes, 1 GiB by default); IoError naming the file otherwise.
