@@ -91,7 +91,7 @@ function(swirl_fuzz_module module out_target)
     if(module STREQUAL "io")  # the HDF5 snapshots, the mesh files
       include(${SWIRL_ROOT}/cmake/hdf5.cmake)
       include(${SWIRL_ROOT}/cmake/assimp.cmake)
-      target_link_libraries(${target} PUBLIC PkgConfig::HDF5 assimp::assimp)
+      target_link_libraries(${target} PUBLIC swirl_hdf5 assimp::assimp)
     endif()
   endif()
   set(${out_target} ${target} PARENT_SCOPE)
