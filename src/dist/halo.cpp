@@ -14,24 +14,42 @@ namespace {
 // Calls visit(cell key) for the cells SortedCellGrid scans around `cell`: the
 // 27 around it (itself included) clipped to the frame's cells per axis, as
 // its row_ranges() and morton_ranges() loops do.
-template <class Visit>
-void for_each_neighbour_cell(const spatial::KeyFrame& f, std::uint64_t cell, Visit&& visit) {
-  const std::uint64_t nx = f.cells[0], ny = f.cells[1], nz = f.cells[2];
+// The cells around `cell` (itself included) clipped to the frame, as the
+// corners of their box: [lo, hi] per axis.
+struct NeighbourBox {
+  std::uint64_t lo[3], hi[3];
+};
+
+std::uint64_t cell_key(const spatial::KeyFrame& f, std::uint64_t x, std::uint64_t y, std::uint64_t z) {
+  return f.curve == spatial::CellOrder::Rows ? (z * f.cells[1] + y) * f.cells[0] + x : morton_key(x, y, z);
+}
+
+NeighbourBox neighbour_box(const spatial::KeyFrame& f, std::uint64_t cell) {
   std::uint64_t c[3];
-  const bool rows = f.curve == spatial::CellOrder::Rows;
-  if (rows) {
-    c[0] = cell % nx;
-    c[1] = (cell / nx) % ny;
-    c[2] = cell / nx / ny;
+  if (f.curve == spatial::CellOrder::Rows) {
+    c[0] = cell % f.cells[0];
+    c[1] = (cell / f.cells[0]) % f.cells[1];
+    c[2] = cell / f.cells[0] / f.cells[1];
   } else {
     c[0] = morton_compact(cell);
     c[1] = morton_compact(cell >> 1);
     c[2] = morton_compact(cell >> 2);
   }
-  for (std::uint64_t z = c[2] > 0 ? c[2] - 1 : 0; z <= std::min(c[2] + 1, nz - 1); ++z)
-    for (std::uint64_t y = c[1] > 0 ? c[1] - 1 : 0; y <= std::min(c[1] + 1, ny - 1); ++y)
-      for (std::uint64_t x = c[0] > 0 ? c[0] - 1 : 0; x <= std::min(c[0] + 1, nx - 1); ++x)
-        visit(rows ? (z * ny + y) * nx + x : morton_key(x, y, z));
+  NeighbourBox box{};
+  for (std::size_t a = 0; a < 3; ++a) {
+    box.lo[a] = c[a] > 0 ? c[a] - 1 : 0;
+    box.hi[a] = std::min(c[a] + 1, std::uint64_t{f.cells[a]} - 1);
+  }
+  return box;
+}
+
+// Calls visit(cell key) for the cells of box: the ones SortedCellGrid scans
+// around the box's centre cell, as its row_ranges() and morton_ranges() loops do.
+template <class Visit>
+void for_each_cell_in(const spatial::KeyFrame& f, const NeighbourBox& box, Visit&& visit) {
+  for (std::uint64_t z = box.lo[2]; z <= box.hi[2]; ++z)
+    for (std::uint64_t y = box.lo[1]; y <= box.hi[1]; ++y)
+      for (std::uint64_t x = box.lo[0]; x <= box.hi[0]; ++x) visit(cell_key(f, x, y, z));
 }
 
 }  // namespace
@@ -65,7 +83,15 @@ Halo Halo::find(const Communicator& comm, const spatial::KeyFrame& frame, std::s
   const unsigned shift = frame.curve == spatial::CellOrder::Rows ? 0u : 3u * frame.cell_shift;
   const std::uint64_t low = shift == 0 ? 0 : (std::uint64_t{1} << shift) - 1;
 
-  // The cells this rank needs from each other rank: around each of its occupied cells.
+  // The cells this rank needs from each other rank: around each of its
+  // occupied cells. Both curves' keys grow with each coordinate, so the keys
+  // of a cell's neighbours lie between its neighbour box's corner keys: when
+  // both corners' particle keys are in this rank's key range, so is every
+  // neighbour, and the cell needs nothing (most cells: only those near the
+  // range's ends, in space, are scanned one neighbour at a time).
+  const std::uint64_t own_lo = h.rank_ > 0 ? cut_keys[static_cast<std::size_t>(h.rank_) - 1] : 0;
+  const bool own_hi_bounded = static_cast<std::size_t>(h.rank_) + 1 < ranks;
+  const std::uint64_t own_hi = own_hi_bounded ? cut_keys[static_cast<std::size_t>(h.rank_)] : 0;
   std::vector<std::vector<std::uint64_t>> want(ranks);
   bool any = false;
   std::uint64_t previous = 0;
@@ -74,7 +100,11 @@ Halo Halo::find(const Communicator& comm, const spatial::KeyFrame& frame, std::s
     if (any && cell == previous) continue;
     any = true;
     previous = cell;
-    for_each_neighbour_cell(frame, cell, [&](std::uint64_t near) {
+    const NeighbourBox box = neighbour_box(frame, cell);
+    const std::uint64_t first_key = cell_key(frame, box.lo[0], box.lo[1], box.lo[2]) << shift;
+    const std::uint64_t last_key = (cell_key(frame, box.hi[0], box.hi[1], box.hi[2]) << shift) | low;
+    if (first_key >= own_lo && (!own_hi_bounded || last_key < own_hi)) continue;
+    for_each_cell_in(frame, box, [&](std::uint64_t near) {
       const std::uint64_t lo = near << shift, hi = lo | low;
       const int from = owner_of(lo, cut_keys), to = owner_of(hi, cut_keys);
       for (int o = from; o <= to; ++o)

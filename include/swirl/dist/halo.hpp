@@ -103,12 +103,18 @@ spatial::KeyFrame global_key_frame(const Communicator& comm, const ParticleSet<R
 }
 
 // Every particle's key in frame f (ParticleOrder::key_of of its position).
+// keys: reused (a step's sort refills the buffer of the last).
 template <class Real>
-std::vector<std::uint64_t> keys_in_frame(const spatial::KeyFrame& f, const ParticleSet<Real>& p) {
-  std::vector<std::uint64_t> keys(p.size());
+void keys_in_frame(const spatial::KeyFrame& f, const ParticleSet<Real>& p, std::vector<std::uint64_t>& keys) {
+  keys.resize(p.size());
   for (std::size_t i = 0; i < keys.size(); ++i)
     keys[i] = spatial::ParticleOrder<Real>::key_of(f, double(p.position.x[i]), double(p.position.y[i]),
                                                    double(p.position.z[i]));
+}
+template <class Real>
+std::vector<std::uint64_t> keys_in_frame(const spatial::KeyFrame& f, const ParticleSet<Real>& p) {
+  std::vector<std::uint64_t> keys;
+  keys_in_frame(f, p, keys);
   return keys;
 }
 

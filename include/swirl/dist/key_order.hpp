@@ -63,6 +63,8 @@ struct DistributeWorkspace {
 // particles[i] has key keys[i] and global index first_global_index + i (the
 // previous order). On return particles and keys hold this rank's range of the
 // new global order. Collective: every rank calls it with the same cut_keys.
+// key_bits: the keys' significant bits (every key < 2^key_bits, checked; the
+// sort looks at no more, as ParticleOrder's at its frame's key_bits).
 //
 // Only the particles that leave are packed into records and sent; those that
 // stay do not move until the one gather that sorts. The new order before the
@@ -73,7 +75,8 @@ struct DistributeWorkspace {
 template <class Real>
 Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>& particles,
                                      std::vector<std::uint64_t>& keys, std::uint64_t first_global_index,
-                                     std::span<const std::uint64_t> cut_keys, DistributeWorkspace<Real>& work) {
+                                     std::span<const std::uint64_t> cut_keys, unsigned key_bits,
+                                     DistributeWorkspace<Real>& work) {
   using Int = typename ParticleSet<Real>::int_type;
   const std::size_t n = particles.size();
   if (keys.size() != n) throw std::invalid_argument("distribute_in_key_order: one key per particle is needed");
@@ -81,6 +84,7 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
     throw std::invalid_argument("distribute_in_key_order: size()-1 cut keys are needed");
   if (!std::is_sorted(cut_keys.begin(), cut_keys.end()))
     throw std::invalid_argument("distribute_in_key_order: cut keys must be nondecreasing");
+  if (key_bits == 0 || key_bits > 64) throw std::invalid_argument("distribute_in_key_order: key_bits must be 1 to 64");
 
   std::size_t real_arrays = 0, int_arrays = 0;
   particles.for_each_array([&](const AlignedVector<Real>&) { ++real_arrays; });
@@ -93,10 +97,14 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
   std::vector<int>& destination = work.destination;
   destination.resize(n);
   std::vector<std::size_t> per_rank(ranks, 0);
+  const std::uint64_t above_bits = key_bits == 64 ? 0 : ~((std::uint64_t{1} << key_bits) - 1);
+  std::uint64_t stray_bits = 0;
   for (std::size_t i = 0; i < n; ++i) {
     destination[i] = owner_of(keys[i], cut_keys);
     ++per_rank[static_cast<std::size_t>(destination[i])];
+    stray_bits |= keys[i] & above_bits;
   }
+  if (stray_bits != 0) throw std::invalid_argument("distribute_in_key_order: a key has bits above key_bits");
   const std::size_t staying = per_rank[static_cast<std::size_t>(me)];
   std::vector<Bytes> send(ranks);
   for (std::size_t d = 0; d < ranks; ++d)
@@ -171,13 +179,19 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
       source[j] = static_cast<std::uint32_t>(next), unsorted[j] = keys[next];
     }
   }
-  work.sorter.sort(unsorted, 64);
+  work.sorter.sort(unsorted, key_bits);
   std::vector<std::uint32_t>& picked = work.picked;
   picked.resize(count);
   const auto order = work.sorter.order();
-  for (std::size_t k = 0; k < count; ++k) picked[k] = source[order[k]];
-  work.reorder.select(particles, picked, kReorderBlock);
-  keys.assign(work.sorter.keys().begin(), work.sorter.keys().end());
+  bool moved = count != n;  // as ParticleOrder: no gather when every particle keeps its place
+  for (std::size_t k = 0; k < count; ++k) {
+    picked[k] = source[order[k]];
+    moved = moved || picked[k] != k;
+  }
+  if (moved) {
+    work.reorder.select(particles, picked, kReorderBlock);
+    keys.assign(work.sorter.keys().begin(), work.sorter.keys().end());
+  }
 
   result.first_global_index = comm.exclusive_prefix_sum(count);
   result.global_count = comm.sum(static_cast<std::uint64_t>(count));
@@ -190,7 +204,7 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
                                      std::vector<std::uint64_t>& keys, std::uint64_t first_global_index,
                                      std::span<const std::uint64_t> cut_keys) {
   DistributeWorkspace<Real> work;
-  return distribute_in_key_order(comm, particles, keys, first_global_index, cut_keys, work);
+  return distribute_in_key_order(comm, particles, keys, first_global_index, cut_keys, 64, work);
 }
 
 }  // namespace swirl::dist

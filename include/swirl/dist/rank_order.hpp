@@ -165,12 +165,13 @@ class RankOrder {
     bool fits = false;
     frame_ = global_key_frame(*comm_, p, request_, fits);
     cells_fit_ = fits;
-    keys_ = keys_in_frame(frame_, p);
+    keys_in_frame(frame_, p, keys_);
     costs_.assign(keys_.size(), 1);
     const bool measured = !cost_rule_ || cost_rule_(costs_);
     bool rebalance = !balanced_;
+    std::vector<std::uint64_t> held;  // the cost each rank holds under the kept cuts
     if (!rebalance) {  // an empty rank (cost 0: every particle costs ≥ 1) always rebalances
-      const std::vector<std::uint64_t> held = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
+      held = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
       rebalance = std::find(held.begin(), held.end(), 0) != held.end() ||
                   (measured && dist::imbalance(held) > rebalance_threshold_);
     }
@@ -179,9 +180,12 @@ class RankOrder {
       balanced_ = true;
       ++rebalances_;
     }
+    const std::vector<std::uint64_t> kept = cut_keys_;
     if (cut_rule_) cut_keys_ = cut_rule_(keys_, std::move(cut_keys_));
-    if (measured || rank_costs_.empty()) rank_costs_ = cost_per_rank(*comm_, keys_, costs_, cut_keys_);
-    const Distribution d = distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_, distribute_work_);
+    if (measured || rank_costs_.empty())
+      rank_costs_ = !rebalance && cut_keys_ == kept ? std::move(held) : cost_per_rank(*comm_, keys_, costs_, cut_keys_);
+    const Distribution d =
+        distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_, frame_.key_bits, distribute_work_);
     first_ = d.first_global_index;
     global_count_ = d.global_count;
     sent_away_ = d.sent_away;
