@@ -223,6 +223,18 @@ TEST(GridCandidates, BoundTheNeighboursAndAreOnePerCell) {
   sph::grid_candidates(grid, {500, 1500}, kBlock, std::span<std::uint64_t>(part));
   EXPECT_TRUE(std::equal(part.begin(), part.end(), all.begin() + 500));
   EXPECT_THROW(sph::grid_candidates(grid, {0, 10}, kBlock, std::span<std::uint64_t>(part)), std::invalid_argument);
+
+  // The density pass counts the same on the way (the ranks' costs), on either kernel path, for a range too.
+  for (const KernelPath path : {KernelPath::Scalar, KernelPath::Simd}) {
+    ParticleSet<double> p = box.p;
+    sph::GridScratch<double> scratch;
+    std::vector<std::uint64_t> counted(1000, 0);
+    sph::grid_density(grid, p, box.k, kBlock, scratch, path, {500, 1500}, std::span<std::uint64_t>(counted));
+    EXPECT_EQ(counted, part) << (path == KernelPath::Simd ? "simd" : "scalar");
+    std::vector<std::uint64_t> wrong(10);
+    EXPECT_THROW(sph::grid_density(grid, p, box.k, kBlock, scratch, path, {500, 1500}, std::span<std::uint64_t>(wrong)),
+                 std::invalid_argument);
+  }
 }
 
 TEST(GridDispatch, EachCopyRunsAtItsOwnWidth) {

@@ -278,6 +278,9 @@ void Halo::insert(const Communicator& comm, ParticleSet<Real>& p, std::vector<st
   // The own particles move to [before, before + n); every ghost slot starts at zero.
   auto make_room = [&](auto& a) {
     using T = typename std::decay_t<decltype(a)>::value_type;
+    // A little headroom, exactly: resize()'s growth would double every field's
+    // capacity, and the ghosts are a few per cent of the particles.
+    if (a.capacity() < m) a.reserve(m + m / 32);
     a.resize(m);
     std::copy_backward(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(n),
                        a.begin() + static_cast<std::ptrdiff_t>(before + n));

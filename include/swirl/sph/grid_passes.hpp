@@ -132,12 +132,25 @@ void grid_candidates(const spatial::SortedCellGrid<Real>& grid, IndexRange only,
 // alone, reading the others as neighbours (a rank's own particles among its
 // ghosts, dist/halo.hpp); the scratch still has one entry per particle. Each
 // particle's result is the same bits as in a pass over all.
+//
+// candidates (optional: empty, or one entry per particle of `only`): each
+// particle's neighbour candidates as grid_candidates() counts them, found on
+// the way (the ranks' cost per particle without a pass of its own).
 template <class Real>
 std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p, const SphLaws<Real>& laws,
-                           std::size_t block_size, GridScratch<Real>& scratch, KernelPath path, IndexRange only) {
+                           std::size_t block_size, GridScratch<Real>& scratch, KernelPath path, IndexRange only,
+                           std::span<std::uint64_t> candidates = {}) {
   const std::size_t n = p.size();
   detail::check_range(only, n);
   const std::size_t from = only.begin, todo = only.end - only.begin;
+  if (!candidates.empty() && candidates.size() != todo)
+    throw std::invalid_argument("SPH grid density: the candidates are not one entry per particle of the range");
+  const auto count_candidates = [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
+    if (candidates.empty()) return;
+    std::uint64_t found = 0;
+    for (int r = 0; r < count; ++r) found += ranges[std::size_t(r)].end - ranges[std::size_t(r)].begin;
+    for (std::size_t i = first; i < last; ++i) candidates[i - from] = found;
+  };
   scratch.volume.resize(n);
   scratch.pressure_volume.resize(n);
   Real *volume = scratch.volume.data(), *pressure_volume = scratch.pressure_volume.data();
@@ -156,6 +169,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
           std::uint64_t pairs = 0;
           detail::for_each_cell(grid, from + b, from + e, [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
             pairs += density_cell_simd(a, first, last, ranges.data(), count);
+            count_candidates(first, last, ranges, count);
           });
           return pairs;
         },
@@ -171,6 +185,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
           const SphLaws<Real> law = laws;
           std::uint64_t pairs = 0;
           detail::for_each_in_cells(grid, from + b, from + e, [&](std::size_t i, const auto& ranges, int count) {
+            count_candidates(i, i + 1, ranges, count);
             Real sum = 0;
             std::uint64_t found = 0;
             for (int r = 0; r < count; ++r)

@@ -24,6 +24,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -53,13 +54,14 @@ inline const std::vector<std::string> kHaloRefreshFields{"density", "pressure"};
 // pressures and writes the own boundary particles' ρ, p, V and pV); when it
 // returns true, density and pressure are exchanged again, so that the ghosts'
 // entries are their owners' after it.
+// candidates: as grid_density's (optional).
 template <class Real, class Between>
 std::uint64_t halo_density_and_forces(const dist::Communicator& comm, dist::Halo& halo,
                                       const spatial::SortedCellGrid<Real>& grid, ParticleSet<Real>& p,
                                       const SphLaws<Real>& laws, std::size_t block_size, GridScratch<Real>& scratch,
-                                      KernelPath path, Between&& between) {
+                                      KernelPath path, Between&& between, std::span<std::uint64_t> candidates = {}) {
   const IndexRange own = halo.owned();
-  const std::uint64_t pairs = grid_density(grid, p, laws, block_size, scratch, path, own);
+  const std::uint64_t pairs = grid_density(grid, p, laws, block_size, scratch, path, own, candidates);
   halo.refresh(comm, p, kHaloRefreshFields);
   if (between()) halo.refresh(comm, p, kHaloRefreshFields);
   // The ghosts' volumes, with the density pass's arithmetic (one division, one product).

@@ -882,19 +882,23 @@ class SphFluid final : public Solver<Real> {
     lists_ = {};
     const SphLaws<Real> k(params_);
     const IndexRange own = halo.owned();
-    record_rank_costs(p, own, ctx.block_size);
+    rank_costs_.assign(own.end - own.begin, 0);  // the density pass counts them (record_rank_costs' figures)
     prepare_boundary(p, ctx.block_size, density_weight(k), own, &halo);
     std::uint64_t pairs = 0;
     {
       PhaseScope phase(ctx, "forces.sph");
       // With boundary particles: p_b from the ghosts' fluid pressures (exchange
       // 2), then the ghosts' p_b (exchange 2 again) before the force pass.
-      pairs = halo_density_and_forces(comm, halo, grid_, p, k, ctx.block_size, scratch_, kernel_path(), [&] {
-        if (!kinds(p)) return false;
-        mirror_boundary(p, ctx.block_size, k, own);
-        return true;
-      });
+      pairs = halo_density_and_forces(
+          comm, halo, grid_, p, k, ctx.block_size, scratch_, kernel_path(),
+          [&] {
+            if (!kinds(p)) return false;
+            mirror_boundary(p, ctx.block_size, k, own);
+            return true;
+          },
+          std::span<std::uint64_t>(rank_costs_));
     }
+    zero_boundary_costs(p, own);
     halo.remove(p, halo_keys_);
     if (kinds(p)) reaction_halo_ = std::move(halo);  // boundary_forces()
     // The mean over all particles: an exact integer sum, then the one-rank division.
@@ -1024,6 +1028,9 @@ class SphFluid final : public Solver<Real> {
   void record_rank_costs(const ParticleSet<Real>& p, IndexRange own, std::size_t block_size) {
     rank_costs_.assign(own.end - own.begin, 0);
     grid_candidates(grid_, own, block_size, std::span<std::uint64_t>(rank_costs_));
+    zero_boundary_costs(p, own);
+  }
+  void zero_boundary_costs(const ParticleSet<Real>& p, IndexRange own) {
     if (const std::int32_t* kind = kinds(p))
       for (std::size_t i = own.begin; i < own.end; ++i)
         if (is_boundary(kind[i])) rank_costs_[i - own.begin] = 0;
