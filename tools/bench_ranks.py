@@ -3,7 +3,8 @@
 
 Runs one scene as 1 rank x T threads and as R ranks x (T/R) threads (mpirun),
 alternately, ROUNDS times, and prints the medians of the stepping time (the
-run's wall time less its frame writing) and of each phase, with the ratio of
+run's wall time less its frame writing) and of the steps alone (less also the
+first evaluation, phase "start") and of each phase, with the ratio of
 medians (ranks / threads). Results are the runs' --summary-json files in OUT.
 
     /usr/bin/python3 tools/bench_ranks.py --swirl build/swirl --scene bench/dfsph/dam_break.toml \\
@@ -36,6 +37,11 @@ def run(cmd, summary: Path, env) -> dict:
 
 def stepping(summary: dict) -> float:
     return summary["wall_seconds"] - summary.get("phase_seconds", {}).get("output", 0.0)
+
+
+def steps_only(summary: dict) -> float:
+    """Stepping less the first evaluation (phase "start": on ranks also the first distribution)."""
+    return stepping(summary) - summary.get("phase_seconds", {}).get("start", 0.0)
 
 
 def main() -> int:
@@ -82,6 +88,9 @@ def main() -> int:
           f"stepping {med['threads']:.2f} s against {med['ranks']:.2f} s, ratio {med['ranks'] / med['threads']:.3f}")
     print("runs:", ", ".join(f"{stepping(s):.2f}" for s in results["threads"]), "|",
           ", ".join(f"{stepping(s):.2f}" for s in results["ranks"]))
+    steps = {m: statistics.median(steps_only(s) for s in results[m]) for m in results}
+    print(f"the steps alone (less the first evaluation, phase start): {steps['threads']:.2f} s against "
+          f"{steps['ranks']:.2f} s, ratio {steps['ranks'] / steps['threads']:.3f}")
     phases = sorted({p for m in results for s in results[m] for p in s.get("phase_seconds", {})})
     print(f"\n| phase | 1 x {args.threads} (s) | {args.ranks} x {per_rank} (s) |\n|---|---:|---:|")
     for p in phases:

@@ -565,7 +565,7 @@ std::size_t bytes_per_particle(const Simulation<Real>& sim) {
   for (const auto& f : p.fields()) bytes += static_cast<std::size_t>(f.components) * sizeof(Real);
   bytes += p.int_field_count() * sizeof(typename ParticleSet<Real>::int_type);
   if (p.empty()) return bytes;
-  std::size_t scratch = sim.order().bytes();
+  std::size_t scratch = sim.ranks() ? sim.ranks()->bytes() : sim.order().bytes();  // on ranks order() is unused
   for (const auto& s : sim.solvers()) scratch += s->scratch_bytes();
   return bytes + scratch / p.size();
 }
@@ -915,7 +915,12 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
 
   dist::Traffic step_traffic;  // this rank's, inside the steps (not the set-up, frames or checkpoints)
   bool going = stage([&] {
-    if (!options.resume) sim.start();  // solvers fill their fields (density, potential) here
+    if (!options.resume) {
+      // Phase "start": the first evaluation (on ranks also the first
+      // distribution of the particles), apart from the steps' own time.
+      ScopedPhase phase(sim.timers(), "start");
+      sim.start();  // solvers fill their fields (density, potential) here
+    }
     summary.bytes_per_particle = bytes_per_particle(sim);
     for (Observer<Real>* o : observers) o->on_start(sim, options.resume);
   });
