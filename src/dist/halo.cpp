@@ -11,9 +11,6 @@ namespace swirl::dist {
 
 namespace {
 
-// Calls visit(cell key) for the cells SortedCellGrid scans around `cell`: the
-// 27 around it (itself included) clipped to the frame's cells per axis, as
-// its row_ranges() and morton_ranges() loops do.
 // The cells around `cell` (itself included) clipped to the frame, as the
 // corners of their box: [lo, hi] per axis.
 struct NeighbourBox {
@@ -43,8 +40,9 @@ NeighbourBox neighbour_box(const spatial::KeyFrame& f, std::uint64_t cell) {
   return box;
 }
 
-// Calls visit(cell key) for the cells of box: the ones SortedCellGrid scans
-// around the box's centre cell, as its row_ranges() and morton_ranges() loops do.
+// Calls visit(cell key) for the cells of box: the 27 (fewer at the frame's
+// faces) SortedCellGrid scans around the box's centre cell, as its
+// row_ranges() and morton_ranges() loops do.
 template <class Visit>
 void for_each_cell_in(const spatial::KeyFrame& f, const NeighbourBox& box, Visit&& visit) {
   for (std::uint64_t z = box.lo[2]; z <= box.hi[2]; ++z)

@@ -916,8 +916,9 @@ RunSummary run_typed(const scene::Scene& scene, const RunOptions& options, std::
   dist::Traffic step_traffic;  // this rank's, inside the steps (not the set-up, frames or checkpoints)
   bool going = stage([&] {
     if (!options.resume) {
-      // Phase "start": the first evaluation (on ranks also the first
-      // distribution of the particles), apart from the steps' own time.
+      // Phase "start": the first evaluation, apart from the steps' own time
+      // (on ranks also rank 0's scatter of the set it built, and the first
+      // distribution in key order).
       ScopedPhase phase(sim.timers(), "start");
       sim.start();  // solvers fill their fields (density, potential) here
     }
