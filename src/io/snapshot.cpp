@@ -8,8 +8,10 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -21,6 +23,7 @@
 
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/read_file.hpp"
+#include "swirl/io/write_faults.hpp"
 
 #if SWIRL_PARALLEL_HDF5
 #include <mpi.h>  // parallel HDF5's MPI-IO driver (builds with MPI: cmake/hdf5.cmake)
@@ -67,6 +70,17 @@ void silence_hdf5() {
 }
 
 // ---- writing -----------------------------------------------------------------
+
+// Dataset writes until an injected failure (io/write_faults.hpp); 0: none.
+std::atomic<int> injected_fault_in{0};
+
+// Whether this dataset write is the one a test asked to fail.
+bool injected_fault_now() {
+  int left = injected_fault_in.load();
+  while (left > 0 && !injected_fault_in.compare_exchange_weak(left, left - 1)) {
+  }
+  return left == 1;
+}
 
 struct Writer {
   fs::path path;  // the file asked for (errors name it, not a temporary one)
@@ -146,7 +160,8 @@ struct Writer {
       for (std::size_t i = 0; i < mine; ++i)
         for (int c = 0; c < columns; ++c) values[i * std::size_t(columns) + std::size_t(c)] = fill(i, c);
       if (!transfer.valid()) {
-        check(H5Dwrite(set->get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()), name, 0);
+        const herr_t status = H5Dwrite(set->get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
+        check(injected_fault_now() ? herr_t(-1) : status, name, 0);
         return;
       }
       // This rank's hyperslab, collectively (a rank without rows selects none).
@@ -159,7 +174,8 @@ struct Writer {
         check(H5Sselect_none(file_space.get()), name, 0);
         check(H5Sselect_none(memory.get()), name, 0);
       }
-      check(H5Dwrite(set->get(), type, memory.get(), file_space.get(), transfer.get(), values.data()), name, 0);
+      const herr_t status = H5Dwrite(set->get(), type, memory.get(), file_space.get(), transfer.get(), values.data());
+      check(injected_fault_now() ? herr_t(-1) : status, name, 0);
     });
   }
 
@@ -173,9 +189,23 @@ struct Writer {
   // gave another file; with every object created first, and one process
   // writing without a chunk cache, the core driver and MPI-IO on 1-4 ranks
   // give the same bytes: tests/dist/snapshot_on_ranks_test.cpp).
+  //
+  // Every queued write runs even after one has failed, and the first failure
+  // is thrown after the last: on several ranks each write is a collective
+  // call, and a rank that stopped at its own failure would leave the others
+  // waiting in the next one (they learn of the failure when the ranks agree
+  // on the outcome, dist/snapshot_on_ranks.cpp).
   void write_queued() {
-    for (auto& write : queued) write();
+    std::exception_ptr first_failure;
+    for (auto& write : queued) {
+      try {
+        write();
+      } catch (const IoError&) {
+        if (!first_failure) first_failure = std::current_exception();
+      }
+    }
     queued.clear();
+    if (first_failure) std::rethrow_exception(first_failure);
   }
   std::vector<std::function<void()>> queued;
 };
@@ -635,5 +665,9 @@ SnapshotLayout read_snapshot_layout(const fs::path& path, std::optional<int> par
     layout.datasets.push_back(o.r.open_dataset(o.group.get(), o.where, name, layout.count).shape);
   return layout;
 }
+
+namespace testing {
+void fail_snapshot_dataset_write(int n) { injected_fault_in.store(n > 0 ? n : 0); }
+}  // namespace testing
 
 }  // namespace swirl::io

@@ -18,6 +18,7 @@
 #include "swirl/dist/snapshot_on_ranks.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/snapshot.hpp"
+#include "swirl/io/write_faults.hpp"
 
 namespace swirl::io {
 namespace {
@@ -104,6 +105,43 @@ TYPED_TEST(SnapshotOnRanks, TheRanksWriteTheOneProcessBytes) {
     const SnapshotFile s = read_snapshot(dir / "ranks_1.h5");
     EXPECT_EQ(s.count, n);
     EXPECT_EQ(s.ids, std::vector<std::uint64_t>(whole.id.begin(), whole.id.end()));
+  }
+}
+
+// One rank's write fails inside the collective sequence (its second dataset,
+// the velocities, as a full disk would refuse it), the others' succeed: every
+// rank still ends the file's collective calls (none waits for the failed rank:
+// without that this test hangs until ctest's timeout) and reports the
+// failed rank's words; the old file stays, no temporary file is left.
+TEST(SnapshotOnRanks, AWriteFailingOnOneRankAloneFailsOnEveryRankWithoutAHang) {
+  const dist::Communicator& comm = dist::Communicator::world();
+  SharedDir dir(comm);
+  const auto p = test::make_particles<double>(1000);
+  if (comm.is_root()) write_file_atomic(dir / "kept.h5", "the old file");
+  comm.barrier();
+  const bool failing = comm.rank() == comm.size() - 1;
+  if (failing) testing::fail_snapshot_dataset_write(2);
+  std::string said;
+  try {
+    dist::write_snapshot_on_ranks(comm, dir / "kept.h5", p, SnapshotInfo{});
+  } catch (const IoError& e) {
+    said = e.what();
+  }
+  testing::fail_snapshot_dataset_write(0);
+  EXPECT_NE(said.find("kept.h5"), std::string::npos) << said;
+  EXPECT_NE(said.find("Velocities"), std::string::npos) << said;
+  EXPECT_EQ(comm.first_text(comm.is_root() ? said : std::string()), said);
+  if (comm.is_root()) {
+    EXPECT_EQ(test::slurp(dir / "kept.h5"), "the old file");
+    std::size_t files = 0;
+    for (const auto& e : fs::directory_iterator(dir.path())) files += e.is_regular_file();
+    EXPECT_EQ(files, 1u) << "a temporary file was left";
+  }
+  comm.barrier();
+  // The next write succeeds.
+  dist::write_snapshot_on_ranks(comm, dir / "kept.h5", p, SnapshotInfo{});
+  if (comm.is_root()) {
+    EXPECT_EQ(read_snapshot(dir / "kept.h5").count, 1000u * std::size_t(comm.size()));
   }
 }
 
