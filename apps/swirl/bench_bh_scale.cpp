@@ -14,7 +14,7 @@
 //   swirl bench bh-scale [--sizes 4096,...,8388608] [--threads 1,2] [--sample 10000] [--opening 0.5,...]
 //                        [--methods barnes_hut,fmm] [--fmm-orders 2,3,4,5] [--fmm-buckets 32,...]
 //                        [--multipoles monopole,quadrupole] [--criteria paper,barnes] [--walks group,particle]
-//                        [--bucket 16,...] [--group-sizes 64,...] [--repeats N] [--precision double,float]
+//                        [--bucket 16,...] [--group-sizes 64,...] [--repeats N] [--warmup N] [--precision double,float]
 //                        [--out DIR] [--quick]
 //
 // Every list is a dimension of the table; the group size applies to the group
@@ -61,6 +61,7 @@ struct BhScaleArgs {
   std::vector<std::size_t> buckets{16};
   std::vector<std::size_t> group_sizes{gravity::GravitySettings{}.group_size};
   int repeats = 0;  // 0: 3 below 2^19 particles, else 1
+  int warmup = 1;   // untimed evaluations first (the buffers' first touch is a run's set-up, not its steps)
   std::vector<std::string> precisions{"double"};
   std::uint64_t seed = 1;
 };
@@ -195,7 +196,12 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
           gravity::GravityField<Real> field;
           std::vector<double> total, build, walk, cpu;
           gravity::GravityStats st;
-          for (int r = 0; r < repeats; ++r) {
+          for (int r = -a.warmup; r < repeats; ++r) {
+            if (r < 0) {  // untimed: allocates and touches the buffers every later evaluation reuses
+              if (fmm) multipole.compute(p, field, 1024);
+              else tree.compute(p, field, 1024);
+              continue;
+            }
             const auto t0 = std::chrono::steady_clock::now();
             const double c0 = cpu_seconds();
             if (fmm) {
@@ -344,9 +350,12 @@ int run_bh_scale(BhScaleArgs a, const bench::CommonArgs& common) {
                   {"bucket", joined(a.buckets)},
                   {"group", joined(a.group_sizes)},
                   {"sample", fmt::format("{}", a.sample)},
+                  {"warmup", fmt::format("{}", a.warmup)},
                   {"precision", joined(a.precisions)}};
   r.tables = {t};
   r.notes =
+      "Timed evaluations follow `warmup` untimed ones on the same tree (its buffers then allocated and touched, "
+      "as for every step of a run after its first). "
       "One force evaluation = tree build (Morton keys, radix sort, nodes from key prefixes, multipoles) + the "
       "walk (`group`: one walk per group of at most `group` particles, its interaction list evaluated by the SIMD "
       "kernels; `particle`: one walk per particle), on a Plummer sphere (Hénon units, ε as given). Force error: |a_tree − a_direct| / "
@@ -408,6 +417,10 @@ void add_bench_bh_scale(CLI::App& bench_cmd, Commands& commands) {
       ->check(whole_number(1, kMaxCount));
   c->add_option("--repeats", args->repeats, "Timed evaluations per point (default 3 below 2^19, else 1)")
       ->check(whole_number(1, kMaxCount));
+  c->add_option("--warmup", args->warmup,
+                "Untimed evaluations before the timed ones, on the same tree (default 1: the first evaluation's "
+                "allocations and page faults are a run's set-up, not its steps; 0 times a cold start)")
+      ->check(whole_number(0, 100));
   c->add_option("--precision", args->precisions, "double,float (default double)")->delimiter(',');
   c->add_option("--seed", args->seed, "Seed of the Plummer sphere and the sample");
   c->add_option("--out", common->out, "Output directory for CSV, JSON, markdown and PNG plots (default bench/bh-scale)");
