@@ -589,7 +589,13 @@ std::vector<SceneKey> declare_scene_keys() {
                      }},
             in_nbody(&GravitySettings::criterion)));
   add(field(SceneKey{.key = "nbody.bucket_size", .section = "nbody", .unit = "particles", .range = kTreeSize,
-                     .doc = "a linear-tree node with more particles is split"},
+                     .doc = "a linear-tree node with more particles is split",
+                     // The FMM's P2P takes whole leaves, its M2L whole cells: larger leaves cost it less (0.67–0.75×
+                     // the time of 32 at 2^16–2^20, docs/performance/fmm.md); Barnes–Hut is fastest near 16.
+                     .default_doc = "`16`; `64` with `method = \"fmm\"`",
+                     .context_default = [](const Scene& s) {
+                       return to_value(std::size_t(s.nbody && s.nbody->method == gravity::Method::Fmm ? 64 : 16));
+                     }},
             in_nbody(&GravitySettings::bucket_size)));
   add(field(SceneKey{.key = "nbody.walk", .section = "nbody", .noun = "walk",
                      .doc = "`\"group\"` (one walk per group of ≤ `group_size` particles, its interaction list evaluated "

@@ -640,7 +640,9 @@ std::pair<io::CheckpointHeader, NamedValues> read_newest_checkpoint(Simulation<R
       NamedValues values;
       const auto h = io::read_checkpoint(file, sim.particles(), values);
       if (h.scene_hash != hash)
-        throw io::IoError(fmt::format("{}: belongs to another scene (hash {:016x}, the scene's is {:016x})",
+        throw io::IoError(fmt::format("{}: belongs to another scene (hash {:016x}, the scene's is {:016x}), or to "
+                                      "this one under a default that has changed since (docs/scenes.md lists "
+                                      "the defaults; a key written out keeps its value)",
                                       file.string(), h.scene_hash, hash));
       summary.last_checkpoint = file;
       return {h, std::move(values)};

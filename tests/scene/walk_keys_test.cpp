@@ -29,6 +29,17 @@ TEST(WalkKeys, ReadsWalkAndGroupSize) {
   EXPECT_NE(scene_hash(o), scene_hash(parse_scene(kNbody, "scene.toml")));
 }
 
+// The leaf size's default follows the method: 16 for Barnes–Hut, 64 for the
+// FMM (its P2P and M2L cost less with larger leaves); a written value wins.
+TEST(WalkKeys, TheBucketSizeDefaultsTo64ForTheFmmOnly) {
+  EXPECT_EQ(parse_scene(kNbody, "scene.toml").nbody->bucket_size, 16u);
+  const Scene fmm = parse_scene(kNbody + "method = \"fmm\"\n", "scene.toml");
+  EXPECT_EQ(fmm.nbody->bucket_size, 64u);
+  const Scene written = parse_scene(kNbody + "method = \"fmm\"\nbucket_size = 16\n", "scene.toml");
+  EXPECT_EQ(written.nbody->bucket_size, 16u);
+  EXPECT_NE(scene_hash(fmm), scene_hash(written));
+}
+
 TEST(WalkKeys, BadValuesNameTheFileKeyAndReason) {
   const std::string walk = test::error_of(kNbody + "walk = \"bogus\"\n");
   EXPECT_EQ(walk.rfind("scene.toml: nbody.walk: ", 0), 0u) << walk;
