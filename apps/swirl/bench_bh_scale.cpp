@@ -196,19 +196,19 @@ void measure(const BhScaleArgs& a, const std::vector<int>& threads, bench::Table
           gravity::GravityField<Real> field;
           std::vector<double> total, build, walk, cpu;
           gravity::GravityStats st;
-          for (int r = -a.warmup; r < repeats; ++r) {
-            if (r < 0) {  // untimed: allocates and touches the buffers every later evaluation reuses
-              if (fmm) multipole.compute(p, field, 1024);
-              else tree.compute(p, field, 1024);
-              continue;
-            }
-            const auto t0 = std::chrono::steady_clock::now();
-            const double c0 = cpu_seconds();
+          const auto evaluate = [&] {
             if (fmm) {
               multipole.compute(p, field, 1024);
             } else {
               tree.compute(p, field, 1024);
             }
+          };
+          // Untimed: allocates and touches the buffers every later evaluation reuses.
+          for (int w = 0; w < a.warmup; ++w) evaluate();
+          for (int r = 0; r < repeats; ++r) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const double c0 = cpu_seconds();
+            evaluate();
             total.push_back(seconds_since(t0));
             cpu.push_back(cpu_seconds() - c0);
             if (fmm) {

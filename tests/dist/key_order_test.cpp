@@ -161,31 +161,37 @@ TEST(KeyOrder, FirstSortAndMigrationGiveTheOneRankStableOrder) {
   if (comm.is_root()) expect_same(second_sort, stable_by_key(moved));
 }
 
+// A cell frame's keys use few bits (ParticleOrder sorts its frame's key_bits):
+// the coarse keys moved to the low 9 bits, sorted by those 9 alone.
 TEST(KeyOrder, SortsOnlyTheKeysBitsAndLeavesAnOrderedRangeInPlace) {
   const Communicator& comm = Communicator::world();
+  constexpr unsigned kBits = 9;
   Local l = initial(comm);
   compute_keys(l);
+  for (std::uint64_t& key : l.keys) key >>= 63 - kBits;
   const std::vector<Row> start = gather_rows(comm, l);
   const std::vector<std::uint64_t> cuts = balanced_cut_keys(comm, l.keys, unit_costs(l));
   DistributeWorkspace<double> work;
-  // The coarse keys use the top 9 of 63 bits: sorting by 63 bits is the full sort.
-  Distribution d = distribute_in_key_order(comm, l.particles, l.keys, l.first, cuts, 63, work);
+  Distribution d = distribute_in_key_order(comm, l.particles, l.keys, l.first, cuts, kBits, work);
   l.first = d.first_global_index;
   const std::vector<Row> sorted = gather_rows(comm, l);
   if (comm.is_root()) expect_same(sorted, stable_by_key(start));
 
-  // Nothing moved: the same keys and cuts keep every particle where it is (no gather).
-  d = distribute_in_key_order(comm, l.particles, l.keys, l.first, cuts, 63, work);
+  // Nothing moved: the same keys and cuts keep every particle where it is,
+  // without the gather (which would swap in other arrays).
+  const double* x_before = l.particles.position.x.data();
+  d = distribute_in_key_order(comm, l.particles, l.keys, l.first, cuts, kBits, work);
   EXPECT_EQ(d.sent_away, 0u);
   EXPECT_EQ(d.first_global_index, l.first);
+  EXPECT_EQ(l.particles.position.x.data(), x_before) << "a range already in order was gathered again";
   const std::vector<Row> again = gather_rows(comm, l);
   if (comm.is_root()) expect_same(again, sorted);
 
   // A key with bits above key_bits is refused (on the rank that holds it; every rank checks before sending).
   std::vector<std::uint64_t> keys = l.keys;
   if (!keys.empty()) {
-    keys[0] |= std::uint64_t{1} << 63;
-    EXPECT_THROW(distribute_in_key_order(comm, l.particles, keys, l.first, cuts, 63, work), std::invalid_argument);
+    keys[0] |= std::uint64_t{1} << kBits;
+    EXPECT_THROW(distribute_in_key_order(comm, l.particles, keys, l.first, cuts, kBits, work), std::invalid_argument);
   }
   EXPECT_THROW(distribute_in_key_order(comm, l.particles, l.keys, l.first, cuts, 0, work), std::invalid_argument);
 }

@@ -180,10 +180,9 @@ class RankOrder {
       balanced_ = true;
       ++rebalances_;
     }
-    const std::vector<std::uint64_t> kept = cut_keys_;
     if (cut_rule_) cut_keys_ = cut_rule_(keys_, std::move(cut_keys_));
-    if (measured || rank_costs_.empty())
-      rank_costs_ = !rebalance && cut_keys_ == kept ? std::move(held) : cost_per_rank(*comm_, keys_, costs_, cut_keys_);
+    if (measured || rank_costs_.empty())  // `held` is for the cuts kept as they were
+      rank_costs_ = !rebalance && !cut_rule_ ? std::move(held) : cost_per_rank(*comm_, keys_, costs_, cut_keys_);
     const Distribution d =
         distribute_in_key_order(*comm_, p, keys_, first_, cut_keys_, frame_.key_bits, distribute_work_);
     first_ = d.first_global_index;

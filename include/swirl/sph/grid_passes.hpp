@@ -102,6 +102,15 @@ inline void check_range(IndexRange only, std::size_t n) {
     throw std::invalid_argument("SPH grid pass: the particles to compute are not a range of the particles");
 }
 
+// The particles in a cell's neighbour ranges: each of the cell's particles'
+// neighbour candidates (grid_candidates()).
+template <class Ranges>
+std::uint64_t candidates_in(const Ranges& ranges, int count) {
+  std::uint64_t candidates = 0;
+  for (int r = 0; r < count; ++r) candidates += ranges[std::size_t(r)].end - ranges[std::size_t(r)].begin;
+  return candidates;
+}
+
 }  // namespace detail
 
 // The neighbour candidates of each particle of `only`: how many particles the
@@ -117,9 +126,7 @@ void grid_candidates(const spatial::SortedCellGrid<Real>& grid, IndexRange only,
   parallel::for_blocks("sph_grid_candidates", out.size(), block_size, [&](std::size_t b, std::size_t e, std::size_t) {
     detail::for_each_cell(grid, from + b, from + e,
                           [&](std::size_t first, std::size_t last, const spatial::NeighbourRanges& ranges, int count) {
-                            std::uint64_t candidates = 0;
-                            for (int r = 0; r < count; ++r)
-                              candidates += ranges[std::size_t(r)].end - ranges[std::size_t(r)].begin;
+                            const std::uint64_t candidates = detail::candidates_in(ranges, count);
                             for (std::size_t i = first; i < last; ++i) out[i - from] = candidates;
                           });
   });
@@ -147,8 +154,7 @@ std::uint64_t grid_density(const spatial::SortedCellGrid<Real>& grid, ParticleSe
     throw std::invalid_argument("SPH grid density: the candidates are not one entry per particle of the range");
   const auto count_candidates = [&](std::size_t first, std::size_t last, const auto& ranges, int count) {
     if (candidates.empty()) return;
-    std::uint64_t found = 0;
-    for (int r = 0; r < count; ++r) found += ranges[std::size_t(r)].end - ranges[std::size_t(r)].begin;
+    const std::uint64_t found = detail::candidates_in(ranges, count);
     for (std::size_t i = first; i < last; ++i) candidates[i - from] = found;
   };
   scratch.volume.resize(n);
