@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 
 #include "swirl/core/morton.hpp"
@@ -91,10 +92,28 @@ Halo Halo::find(const Communicator& comm, const spatial::KeyFrame& frame, std::s
   const bool own_hi_bounded = static_cast<std::size_t>(h.rank_) + 1 < ranks;
   const std::uint64_t own_hi = own_hi_bounded ? cut_keys[static_cast<std::size_t>(h.rank_)] : 0;
   std::vector<std::vector<std::uint64_t>> want(ranks);
+  // Row-major keys: a neighbour's key differs from the cell's by at most one
+  // layer and one row and one cell, so only the keys within that reach of the
+  // range's ends can need ghosts; the scan skips the middle. (Morton keys have
+  // no such bound: every cell is looked at, most of them by its corners alone.)
+  std::size_t skip_begin = 0, skip_end = 0;
+  if (frame.curve == spatial::CellOrder::Rows) {
+    const std::uint64_t reach = frame.cells[0] * frame.cells[1] + frame.cells[0] + 1;
+    const auto at = [&](std::uint64_t key) {
+      return static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), key) - keys.begin());
+    };
+    skip_begin = h.rank_ > 0 ? (own_lo > std::numeric_limits<std::uint64_t>::max() - reach ? keys.size() : at(own_lo + reach)) : 0;
+    skip_end = own_hi_bounded ? (own_hi < reach ? 0 : at(own_hi - reach)) : keys.size();
+    if (skip_end < skip_begin) skip_end = skip_begin;
+  }
   bool any = false;
   std::uint64_t previous = 0;
-  for (const std::uint64_t key : keys) {
-    const std::uint64_t cell = frame.cell_of(key);
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (i == skip_begin && skip_end > skip_begin) {
+      i = skip_end - 1;
+      continue;
+    }
+    const std::uint64_t cell = frame.cell_of(keys[i]);
     if (any && cell == previous) continue;
     any = true;
     previous = cell;

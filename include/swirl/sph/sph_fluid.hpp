@@ -750,8 +750,17 @@ class SphFluid final : public Solver<Real> {
     if (!kind) return false;
     // Counted at every evaluation: inlets and outlets change the fluid count
     // (sim/inlets_outlets.hpp), and the solves' average errors divide by it.
-    const std::size_t mine = count_fluid(p, own);
-    fluid_count_ = ranks_ ? static_cast<std::size_t>(ranks_->comm().sum(std::uint64_t{mine})) : mine;
+    // On several ranks the sum is a collective between the ghosts' insert and
+    // the density pass, where the ranks' different shares of the insert's work
+    // would wait for each other: it is summed only when the particle count
+    // changed (no rank creates or removes a particle: inlets and outlets do
+    // not run on ranks, and no particle changes kind), and at the first call.
+    if (!ranks_)
+      fluid_count_ = count_fluid(p, own);
+    else if (fluid_count_for_ != ranks_->global_count()) {
+      fluid_count_ = static_cast<std::size_t>(ranks_->comm().sum(std::uint64_t{count_fluid(p, own)}));
+      fluid_count_for_ = ranks_->global_count();
+    }
     if (boundary_volumes_ && !moving_boundaries_) return false;
     const Real *x = p.position.x.data(), *y = p.position.y.data(), *z = p.position.z.data();
     Real* m = p.mass.data();
@@ -1196,6 +1205,7 @@ class SphFluid final : public Solver<Real> {
   ParticleSet<Real> ghost_set_;
   std::vector<std::uint64_t> ghost_keys_;
   std::size_t fluid_count_ = 0;    // fluid particles at the last evaluation (of all ranks)
+  std::uint64_t fluid_count_for_ = std::numeric_limits<std::uint64_t>::max();  // the ranks' particle count it was summed at
 };
 
 }  // namespace swirl::sph
