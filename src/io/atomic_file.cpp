@@ -74,31 +74,53 @@ void sync_directory(const fs::path& path) {
 
 }  // namespace
 
-void write_file_atomic(const fs::path& path, std::string_view bytes, bool sync) {
+AtomicFileWriter::AtomicFileWriter(const fs::path& path) : path_(path) {
   if (path.filename().empty()) throw IoError(fmt::format("{}: not a file name", path.string()));
-  TempFile tmp(unique_sibling(path, "tmp"));
-  if (tmp.open() < 0) {
-    int err = errno;
-    fail(path, fmt::format("cannot create temporary file {}", tmp.path().string()), err);
-  }
+  temporary_ = unique_sibling(path, "tmp");
+  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd_ < 0) fail(path, fmt::format("cannot create temporary file {}", temporary_.string()), errno);
+}
 
+AtomicFileWriter::~AtomicFileWriter() {
+  if (fd_ >= 0) ::close(fd_);
+  if (!committed_) ::unlink(temporary_.c_str());
+}
+
+void AtomicFileWriter::append(std::string_view bytes) {
+  if (fd_ < 0) throw IoError(fmt::format("{}: written after it was committed or failed", path_.string()));
   const char* p = bytes.data();
   std::size_t left = bytes.size();
   while (left > 0) {
-    ssize_t n = ::write(tmp.fd(), p, left);
+    ssize_t n = ::write(fd_, p, left);
     if (n < 0) {
       if (errno == EINTR) continue;
-      fail(path, "write failed", errno);
+      const int err = errno;
+      ::close(fd_);
+      fd_ = -1;
+      fail(path_, "write failed", err);
     }
     p += n;
     left -= static_cast<std::size_t>(n);
   }
-  if (sync && ::fsync(tmp.fd()) != 0) fail(path, "fsync failed", errno);
+  written_ += bytes.size();
+}
+
+void AtomicFileWriter::commit(bool sync) {
+  if (fd_ < 0) throw IoError(fmt::format("{}: committed twice or after a failed write", path_.string()));
+  if (sync && ::fsync(fd_) != 0) fail(path_, "fsync failed", errno);
   // Delayed-allocation file systems may report ENOSPC or EIO only here.
-  if (tmp.close() != 0) fail(path, "close failed", errno);
-  if (::rename(tmp.path().c_str(), path.c_str()) != 0) fail(path, "cannot rename the temporary file over it", errno);
-  tmp.release();
-  if (sync) sync_directory(path);
+  const int fd = fd_;
+  fd_ = -1;  // close() releases the descriptor even when it reports an error
+  if (::close(fd) != 0) fail(path_, "close failed", errno);
+  if (::rename(temporary_.c_str(), path_.c_str()) != 0) fail(path_, "cannot rename the temporary file over it", errno);
+  committed_ = true;
+  if (sync) sync_directory(path_);
+}
+
+void write_file_atomic(const fs::path& path, std::string_view bytes, bool sync) {
+  AtomicFileWriter file(path);
+  file.append(bytes);
+  file.commit(sync);
 }
 
 fs::path temporary_sibling(const fs::path& path) {

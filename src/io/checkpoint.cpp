@@ -1,6 +1,7 @@
 #include "swirl/io/checkpoint.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstring>
 #include <limits>
@@ -13,6 +14,7 @@
 #include "detail.hpp"
 #include "swirl/io/read_file.hpp"
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/io/write_faults.hpp"
 
 namespace swirl::io {
 namespace {
@@ -23,8 +25,20 @@ constexpr std::string_view kMagic = "SWIRLCKP";
 constexpr std::uint32_t kMaxName = 256, kMaxFields = 64, kMaxValues = 64;
 constexpr std::uint64_t kMaxParticles = std::uint64_t{1} << 31;
 
-std::uint64_t fnv1a(std::string_view bytes) {
-  std::uint64_t h = 0xcbf29ce484222325u;
+// Checkpoint appends until an injected failure (io/write_faults.hpp); 0: none.
+std::atomic<int> injected_append_fault_in{0};
+
+bool injected_append_fault_now() {
+  int left = injected_append_fault_in.load();
+  while (left > 0 && !injected_append_fault_in.compare_exchange_weak(left, left - 1)) {
+  }
+  return left == 1;
+}
+
+constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325u;
+
+// FNV-1a 64 of `bytes` continued from h (kFnvOffset: from the start).
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = kFnvOffset) {
   for (const char c : bytes) {
     h ^= static_cast<unsigned char>(c);
     h *= 0x100000001b3u;
@@ -213,41 +227,81 @@ CheckpointHeader parse(std::string_view bytes, ParticleSet<Real>& particles, Che
 }  // namespace
 
 template <class Real>
-void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>& particles,
-                      const CheckpointHeader& header, const CheckpointValues& values) {
+CheckpointLayout CheckpointLayout::of(const ParticleSet<Real>& particles) {
+  CheckpointLayout layout;
+  for (const auto& f : particles.fields())
+    layout.fields.emplace_back(std::string(f.name), static_cast<std::uint32_t>(f.components));
+  for (const auto& f : particles.int_fields()) layout.int_fields.emplace_back(f.name);
+  return layout;
+}
+
+CheckpointWriter::CheckpointWriter(const std::filesystem::path& path, const CheckpointHeader& header,
+                                   const CheckpointLayout& layout, const CheckpointValues& values)
+    : file_(path), path_(path), hash_(kFnvOffset) {
+  if (header.real_bytes != 4 && header.real_bytes != 8)
+    throw std::invalid_argument("checkpoint writer: reals of 4 or 8 bytes");
+  std::uint64_t arrays = 0;
+  for (const auto& field : layout.fields) arrays += field.second;
+  expected_ = header.particles * (arrays * header.real_bytes + layout.int_fields.size() * sizeof(std::int32_t) +
+                                  sizeof(std::uint64_t));
   std::string out;
-  using Int = typename ParticleSet<Real>::int_type;
-  const auto fields = particles.fields();
-  const auto int_fields = particles.int_fields();
-  std::size_t data = particles.size() * (sizeof(std::uint64_t) + int_fields.size() * sizeof(Int));
-  for (const auto& f : fields) data += static_cast<std::size_t>(f.components) * particles.size() * sizeof(Real);
-  out.reserve(data + 4096);
   out.append(kMagic);
   put<std::uint32_t>(out, kCheckpointVersion);
-  put<std::uint32_t>(out, sizeof(Real));
-  put<std::uint64_t>(out, particles.size());
+  put<std::uint32_t>(out, header.real_bytes);
+  put<std::uint64_t>(out, header.particles);
   put<std::uint64_t>(out, header.scene_hash);
   put<std::uint64_t>(out, header.step);
   put<double>(out, header.time);
-  put<std::uint32_t>(out, static_cast<std::uint32_t>(fields.size()));
-  for (const auto& f : fields) {
-    put_name(out, f.name);
-    put<std::uint32_t>(out, static_cast<std::uint32_t>(f.components));
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(layout.fields.size()));
+  for (const auto& [name, components] : layout.fields) {
+    put_name(out, name);
+    put<std::uint32_t>(out, components);
   }
-  put<std::uint32_t>(out, static_cast<std::uint32_t>(int_fields.size()));
-  for (const auto& f : int_fields) put_name(out, f.name);
+  put<std::uint32_t>(out, static_cast<std::uint32_t>(layout.int_fields.size()));
+  for (const auto& name : layout.int_fields) put_name(out, name);
   put<std::uint32_t>(out, static_cast<std::uint32_t>(values.size()));
   for (const auto& [name, value] : values) {
     put_name(out, name);
     put<double>(out, value);
   }
-  for (const auto& f : fields)
-    for (int c = 0; c < f.components; ++c)
-      out.append(reinterpret_cast<const char*>(f.data[c]), particles.size() * sizeof(Real));
-  for (const auto& f : int_fields) out.append(reinterpret_cast<const char*>(f.data[0]), particles.size() * sizeof(Int));
-  out.append(reinterpret_cast<const char*>(particles.id.data()), particles.size() * sizeof(std::uint64_t));
-  put<std::uint64_t>(out, fnv1a(out));
-  write_file_atomic(path, out, /*sync=*/true);
+  hash_ = fnv1a(out, hash_);
+  file_.append(out);
+}
+
+void CheckpointWriter::append(std::string_view data) {
+  if (data.size() > expected_ - appended_)
+    throw std::logic_error("checkpoint writer: more data than the header announces");
+  hash_ = fnv1a(data, hash_);
+  file_.append(data);
+  appended_ += data.size();
+  if (injected_append_fault_now())  // a test's (io/write_faults.hpp): as a full disk would refuse
+    throw IoError(fmt::format("{}: write failed: no space left on device (injected by a test)", path_.string()));
+}
+
+void CheckpointWriter::finish() {
+  if (appended_ != expected_) throw std::logic_error("checkpoint writer: less data than the header announces");
+  std::string checksum;
+  put<std::uint64_t>(checksum, hash_);
+  file_.append(checksum);
+  file_.commit(/*sync=*/true);
+}
+
+template <class Real>
+void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>& particles,
+                      const CheckpointHeader& header, const CheckpointValues& values) {
+  using Int = typename ParticleSet<Real>::int_type;
+  CheckpointHeader h = header;
+  h.real_bytes = sizeof(Real);
+  h.particles = particles.size();
+  CheckpointWriter out(path, h, CheckpointLayout::of(particles), values);
+  const auto array = [&](const auto* data, std::size_t bytes) {
+    out.append(std::string_view(reinterpret_cast<const char*>(data), bytes));
+  };
+  for (const auto& f : particles.fields())
+    for (int c = 0; c < f.components; ++c) array(f.data[c], particles.size() * sizeof(Real));
+  for (const auto& f : particles.int_fields()) array(f.data[0], particles.size() * sizeof(Int));
+  array(particles.id.data(), particles.size() * sizeof(std::uint64_t));
+  out.finish();
 }
 
 template <class Real>
@@ -276,6 +330,8 @@ CheckpointHeader read_checkpoint_header(const std::filesystem::path& path) {
   }
 }
 
+template CheckpointLayout CheckpointLayout::of<float>(const ParticleSet<float>&);
+template CheckpointLayout CheckpointLayout::of<double>(const ParticleSet<double>&);
 template void write_checkpoint<float>(const std::filesystem::path&, const ParticleSet<float>&, const CheckpointHeader&,
                                       const CheckpointValues&);
 template void write_checkpoint<double>(const std::filesystem::path&, const ParticleSet<double>&,
@@ -287,5 +343,9 @@ template CheckpointHeader parse_checkpoint<float>(std::string_view, std::string_
                                                   CheckpointValues&);
 template CheckpointHeader parse_checkpoint<double>(std::string_view, std::string_view, ParticleSet<double>&,
                                                    CheckpointValues&);
+
+namespace testing {
+void fail_checkpoint_append(int n) { injected_append_fault_in.store(n > 0 ? n : 0); }
+}  // namespace testing
 
 }  // namespace swirl::io

@@ -82,7 +82,8 @@ Footprint footprint(const scene::Scene& scene, int ranks) {
   const double rank = (mine + ghosts) * (fields + solver) + ghosts * fields + imported + fixed;
   f.memory.assign(static_cast<std::size_t>(ranks), rank);
   // Rank 0 builds the whole set (and the scene's double copy), and gathers
-  // it for every frame and checkpoint, which its writer encodes: 288 B a
+  // it for every VTK or CSV frame, which its writer encodes (checkpoints and
+  // HDF5 frames gather nothing whole; the building peak alone is of that order): 288 B a
   // particle in float, where the dam break at 3.84·10⁶ particles on 8 ranks
   // measured 340 B (docs/design/mpi.md).
   f.memory[0] += n * (2 * fields + building + (fields + 16));

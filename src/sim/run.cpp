@@ -19,6 +19,7 @@
 #include "swirl/dist/gather_particles.hpp"
 #include "swirl/dist/snapshot_on_ranks.hpp"
 #include "swirl/io/atomic_file.hpp"
+#include "swirl/dist/checkpoint_on_ranks.hpp"
 #include "swirl/io/checkpoint.hpp"
 #include "swirl/io/csv.hpp"
 #include "swirl/io/frame_names.hpp"
@@ -39,6 +40,25 @@
 
 namespace swirl::sim {
 namespace {
+
+// Claims `path` in the run folder (rank 0's; null on the other ranks) and
+// returns the claimed name on every rank, or throws rank 0's IoError on every
+// rank: the start of a write the ranks make together.
+std::filesystem::path claim_on_every_rank(io::RunFolder* folder, const dist::Communicator* ranks,
+                                          const std::filesystem::path& path, bool sync = false) {
+  std::string error;
+  std::filesystem::path claimed = path;
+  if (folder) {
+    try {
+      claimed = folder->claim(path, sync);
+    } catch (const io::IoError& e) {
+      error = e.what();
+    }
+  }
+  if (ranks) error = ranks->first_text(error);
+  if (!error.empty()) throw io::IoError(error);
+  return claimed;
+}
 
 // ---------------------------------------------------------------------------
 // Frames: particles_NNNNNN.vtp/.h5/.csv at the output interval, frame 0 at
@@ -190,7 +210,7 @@ class FrameWriter final : public Observer<Real> {
       std::filesystem::path file;
       if (format == scene::OutputFormat::Hdf5) {
         const std::string name = io::frame_file_name(series.name, frames_, ".h5");
-        file = claim_on_every_rank(ranks, dir_ / name);
+        file = claim_on_every_rank(folder_, ranks, dir_ / name);
         io::SnapshotInfo info = snapshot_info_;
         info.time = time;
         info.type = series.type;
@@ -224,21 +244,6 @@ class FrameWriter final : public Observer<Real> {
   // Rank 0 claims `path` in the run folder (it alone keeps the folder); on
   // ranks every rank learns whether it could, so that a collective write is
   // started by every rank or by none. Throws IoError on every rank otherwise.
-  std::filesystem::path claim_on_every_rank(const dist::Communicator* ranks, const std::filesystem::path& path) {
-    std::string error;
-    std::filesystem::path claimed = path;
-    if (folder_) {
-      try {
-        claimed = folder_->claim(path);
-      } catch (const io::IoError& e) {
-        error = e.what();
-      }
-    }
-    if (ranks) error = ranks->first_text(error);
-    if (!error.empty()) throw io::IoError(error);
-    return claimed;
-  }
-
   bool has(scene::OutputFormat format) const {
     return std::find(formats_.begin(), formats_.end(), format) != formats_.end();
   }
@@ -463,14 +468,18 @@ class Checkpointer final : public Observer<Real> {
     ScopedPhase phase(sim.timers(), "output");
     NamedValues values;
     collect_(values);
-    const ParticleSet<Real>& whole = sim.whole_particles();  // collective on ranks
     const auto path = checkpoint_dir(options_.out_dir) / fmt::format("checkpoint_{:012d}.swc", sim.step_count());
     last_ = path;
-    if (!folder_) return;  // a rank other than 0: rank 0 writes
+    const dist::Communicator* ranks = sim.ranks() ? &sim.ranks()->comm() : nullptr;
     // Claimed (and the manifest synced) before it is written: a resume after a
     // power cut still knows it is this run's.
-    const auto file = folder_->claim(path, /*sync=*/true);
-    io::write_checkpoint(file, whole, {sizeof(Real), whole.size(), hash_, sim.step_count(), sim.time()}, values);
+    const auto file = claim_on_every_rank(folder_, ranks, path, /*sync=*/true);
+    const io::CheckpointHeader header{sizeof(Real), sim.particles().size(), hash_, sim.step_count(), sim.time()};
+    if (ranks)  // rank 0 writes while the ranks hand it one field at a time
+      dist::write_checkpoint_on_ranks(*ranks, file, sim.particles(), header, values);
+    else
+      io::write_checkpoint(file, sim.particles(), header, values);
+    if (!folder_) return;  // a rank other than 0
     last_ = file;
     const auto files = checkpoints_in(*folder_);
     for (std::size_t k = std::max<std::size_t>(options_.checkpoint_keep, 1); k < files.size(); ++k)

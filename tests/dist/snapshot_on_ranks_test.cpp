@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "dist/shared_dir.hpp"
 #include "io/io_test_util.hpp"
 #include "swirl/dist/snapshot_on_ranks.hpp"
 #include "swirl/io/atomic_file.hpp"
@@ -25,30 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// One folder for every rank: rank 0 makes it and says where.
-class SharedDir {
- public:
-  explicit SharedDir(const dist::Communicator& comm) : comm_(comm) {
-    if (comm.is_root()) own_ = std::make_unique<test::TempDir>();
-    path_ = comm.first_text(comm.is_root() ? own_->path().string() : std::string());
-  }
-  ~SharedDir() { comm_.barrier(); }  // every rank done with it before rank 0 removes it
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  const dist::Communicator& comm_;
-  std::unique_ptr<test::TempDir> own_;
-  fs::path path_;
-};
-
-// Rank r's share [cut[r], cut[r+1]) of n particles by `pattern`: 0 even, 1
-// growing shares (r² steps), 2 all on the last rank (the others empty).
-std::vector<std::size_t> cuts(std::size_t n, std::size_t ranks, int pattern) {
-  std::vector<std::size_t> cut(ranks + 1, n);
-  for (std::size_t r = 0; r < ranks; ++r) cut[r] = pattern == 0 ? n * r / ranks : pattern == 1 ? n * r * r / (ranks * ranks) : 0;
-  return cut;
-}
+using test::SharedDir;
 
 template <class Real>
 class SnapshotOnRanks : public ::testing::Test {};
@@ -75,7 +53,7 @@ TYPED_TEST(SnapshotOnRanks, TheRanksWriteTheOneProcessBytes) {
   if (comm.is_root()) write_snapshot(dir / "one_rows.h5", whole, info, std::span<const std::size_t>(every_third));
   int compared = 0;
   for (int pattern = 0; pattern < 3; ++pattern) {
-    const auto cut = cuts(n, ranks, pattern);
+    const auto cut = test::rank_cuts(n, ranks, pattern);
     std::vector<std::size_t> mine(cut[r + 1] - cut[r]);
     std::iota(mine.begin(), mine.end(), cut[r]);
     const auto own = whole.subset(mine);
@@ -133,9 +111,7 @@ TEST(SnapshotOnRanks, AWriteFailingOnOneRankAloneFailsOnEveryRankWithoutAHang) {
   EXPECT_EQ(comm.first_text(comm.is_root() ? said : std::string()), said);
   if (comm.is_root()) {
     EXPECT_EQ(test::slurp(dir / "kept.h5"), "the old file");
-    std::size_t files = 0;
-    for (const auto& e : fs::directory_iterator(dir.path())) files += e.is_regular_file();
-    EXPECT_EQ(files, 1u) << "a temporary file was left";
+    EXPECT_EQ(test::regular_files(dir.path()), 1u) << "a temporary file was left";
   }
   comm.barrier();
   // The next write succeeds.
@@ -170,9 +146,7 @@ TEST(SnapshotOnRanks, AFailedWriteFailsOnEveryRankAndKeepsTheOldFile) {
   if (comm.is_root()) {
     EXPECT_EQ(read_snapshot(dir / "kept.h5").count, 100u * std::size_t(comm.size()));
     // No temporary file is left beside it.
-    std::size_t files = 0;
-    for (const auto& e : fs::directory_iterator(dir.path())) files += e.is_regular_file();
-    EXPECT_EQ(files, 1u);
+    EXPECT_EQ(test::regular_files(dir.path()), 1u);
   }
 }
 

@@ -3,9 +3,11 @@
 // gather_to_root(): the ranks' particles concatenated in rank order on rank 0
 // (every field, bit for bit; the other ranks get an empty set with the same
 // fields). Under the distributed order's invariant (dist/key_order.hpp) that
-// is the one-rank memory order, so a frame or a checkpoint written from it is
-// the one-rank file byte for byte. It holds every particle on rank 0 for the
-// time of one write: the simple first step before parallel HDF5 (issue 19 item 6).
+// is the one-rank memory order, so a frame written from it is the one-rank
+// file byte for byte. It holds every particle on rank 0 for the time of one
+// write: what the VTK and CSV frames still use (HDF5 frames are written by
+// every rank, dist/snapshot_on_ranks.hpp; checkpoints streamed to rank 0 one
+// array at a time, dist/checkpoint_on_ranks.hpp).
 //
 // keep_range(): drops every particle outside [begin, end) and gives the rest
 // of the memory back (a rank taking its slice of a set it holds whole).

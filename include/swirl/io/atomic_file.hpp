@@ -23,6 +23,30 @@ class IoError : public std::runtime_error {
 // thrown.
 void write_file_atomic(const std::filesystem::path& path, std::string_view bytes, bool sync = false);
 
+// The same for a file written piece by piece (a checkpoint streamed from the
+// ranks, io/checkpoint.hpp), so that its bytes never need to be in memory at
+// once: append() writes to the temporary file, commit() publishes it as
+// write_file_atomic() does. Destroyed without commit() (an exception, a
+// failed append), it removes the temporary file and `path` stays as it was.
+// Every failure throws IoError naming `path`.
+class AtomicFileWriter {
+ public:
+  explicit AtomicFileWriter(const std::filesystem::path& path);
+  AtomicFileWriter(const AtomicFileWriter&) = delete;
+  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
+  ~AtomicFileWriter();
+
+  void append(std::string_view bytes);
+  void commit(bool sync);
+  std::uint64_t bytes_written() const { return written_; }
+
+ private:
+  std::filesystem::path path_, temporary_;
+  int fd_ = -1;
+  bool committed_ = false;
+  std::uint64_t written_ = 0;
+};
+
 // The same for a file that something else fills (the ranks of a parallel
 // HDF5 write, dist/snapshot_on_ranks.hpp): temporary_sibling() names a
 // temporary file beside `path`, unique to this process; once it is complete,

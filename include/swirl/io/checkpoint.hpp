@@ -54,10 +54,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
 #include "swirl/core/particle_set.hpp"
+#include "swirl/io/atomic_file.hpp"
 
 namespace swirl::io {
 
@@ -74,6 +76,42 @@ struct CheckpointHeader {
 };
 
 using CheckpointValues = std::vector<std::pair<std::string, double>>;
+
+// The fields of a checkpoint in the file's order: every real field with its
+// components, then every integer field (a ParticleSet's fields() and
+// int_fields(), in that order).
+struct CheckpointLayout {
+  std::vector<std::pair<std::string, std::uint32_t>> fields;  // name, components
+  std::vector<std::string> int_fields;
+
+  template <class Real>
+  static CheckpointLayout of(const ParticleSet<Real>& particles);
+};
+
+// Writes one checkpoint piece by piece, so that neither the file nor the whole
+// particle set needs to be in memory at once (on several ranks rank 0 writes
+// one field of every rank at a time: dist/checkpoint_on_ranks.hpp). The
+// constructor writes the header (version kCheckpointVersion, header.real_bytes
+// and header.particles as given) to a temporary file beside `path`; append()
+// takes the data in the file's order (each real field's components, each
+// integer field, the ids: header.particles values each; an array may come in
+// several pieces); finish() adds the checksum and publishes the file
+// atomically and durably. Destroyed unfinished (an exception), it leaves
+// `path` as it was and no temporary file. IoError for the file system's
+// refusals; std::logic_error for more or less data than the header announces.
+class CheckpointWriter {
+ public:
+  CheckpointWriter(const std::filesystem::path& path, const CheckpointHeader& header, const CheckpointLayout& layout,
+                   const CheckpointValues& values);
+  void append(std::string_view data);
+  void finish();
+
+ private:
+  AtomicFileWriter file_;
+  std::filesystem::path path_;
+  std::uint64_t hash_;
+  std::uint64_t expected_ = 0, appended_ = 0;  // data bytes
+};
 
 // Writes a checkpoint atomically and durably (temporary file, fsync, rename).
 template <class Real>
@@ -99,6 +137,8 @@ template <class Real>
 CheckpointHeader parse_checkpoint(std::string_view bytes, std::string_view name, ParticleSet<Real>& particles,
                                   CheckpointValues& values);
 
+extern template CheckpointLayout CheckpointLayout::of<float>(const ParticleSet<float>&);
+extern template CheckpointLayout CheckpointLayout::of<double>(const ParticleSet<double>&);
 extern template void write_checkpoint<float>(const std::filesystem::path&, const ParticleSet<float>&,
                                              const CheckpointHeader&, const CheckpointValues&);
 extern template void write_checkpoint<double>(const std::filesystem::path&, const ParticleSet<double>&,
