@@ -102,7 +102,6 @@ void AtomicFileWriter::append(std::string_view bytes) {
     p += n;
     left -= static_cast<std::size_t>(n);
   }
-  written_ += bytes.size();
 }
 
 void AtomicFileWriter::commit(bool sync) {

@@ -16,10 +16,10 @@
 #include <fmt/format.h>
 
 #include "swirl/core/particle_kind.hpp"
+#include "swirl/dist/checkpoint_on_ranks.hpp"
 #include "swirl/dist/gather_particles.hpp"
 #include "swirl/dist/snapshot_on_ranks.hpp"
 #include "swirl/io/atomic_file.hpp"
-#include "swirl/dist/checkpoint_on_ranks.hpp"
 #include "swirl/io/checkpoint.hpp"
 #include "swirl/io/csv.hpp"
 #include "swirl/io/frame_names.hpp"
@@ -41,9 +41,10 @@
 namespace swirl::sim {
 namespace {
 
-// Claims `path` in the run folder (rank 0's; null on the other ranks) and
-// returns the claimed name on every rank, or throws rank 0's IoError on every
-// rank: the start of a write the ranks make together.
+// Claims `path` in the run folder (rank 0's: it alone keeps the folder; null
+// on the other ranks) and returns the claimed name on every rank, or throws
+// rank 0's IoError on every rank: a write the ranks make together is started
+// by every rank or by none.
 std::filesystem::path claim_on_every_rank(io::RunFolder* folder, const dist::Communicator* ranks,
                                           const std::filesystem::path& path, bool sync = false) {
   std::string error;
@@ -241,9 +242,6 @@ class FrameWriter final : public Observer<Real> {
     return first;
   }
 
-  // Rank 0 claims `path` in the run folder (it alone keeps the folder); on
-  // ranks every rank learns whether it could, so that a collective write is
-  // started by every rank or by none. Throws IoError on every rank otherwise.
   bool has(scene::OutputFormat format) const {
     return std::find(formats_.begin(), formats_.end(), format) != formats_.end();
   }

@@ -38,13 +38,11 @@ class AtomicFileWriter {
 
   void append(std::string_view bytes);
   void commit(bool sync);
-  std::uint64_t bytes_written() const { return written_; }
 
  private:
   std::filesystem::path path_, temporary_;
   int fd_ = -1;
   bool committed_ = false;
-  std::uint64_t written_ = 0;
 };
 
 // The same for a file that something else fills (the ranks of a parallel
