@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <limits>
 #include <stdexcept>
 
 #include "swirl/core/morton.hpp"
@@ -94,40 +93,39 @@ Halo Halo::find(const Communicator& comm, const spatial::KeyFrame& frame, std::s
   std::vector<std::vector<std::uint64_t>> want(ranks);
   // Row-major keys: a neighbour's key differs from the cell's by at most one
   // layer and one row and one cell, so only the keys within that reach of the
-  // range's ends can need ghosts; the scan skips the middle. (Morton keys have
-  // no such bound: every cell is looked at, most of them by its corners alone.)
-  std::size_t skip_begin = 0, skip_end = 0;
+  // range's ends can need ghosts: the keys [0, low_end) and [high_begin, n)
+  // are scanned, the middle skipped. (Morton keys have no such bound: every
+  // cell is looked at, most of them by its corners alone.)
+  std::size_t low_end = keys.size(), high_begin = keys.size();
   if (frame.curve == spatial::CellOrder::Rows) {
     const std::uint64_t reach = frame.cells[0] * frame.cells[1] + frame.cells[0] + 1;
-    const auto at = [&](std::uint64_t key) {
+    const auto first_at = [&](std::uint64_t key) {
       return static_cast<std::size_t>(std::lower_bound(keys.begin(), keys.end(), key) - keys.begin());
     };
-    skip_begin = h.rank_ > 0 ? (own_lo > std::numeric_limits<std::uint64_t>::max() - reach ? keys.size() : at(own_lo + reach)) : 0;
-    skip_end = own_hi_bounded ? (own_hi < reach ? 0 : at(own_hi - reach)) : keys.size();
-    if (skip_end < skip_begin) skip_end = skip_begin;
+    // Cells below own_lo + reach may need a lower rank's; at or above own_hi − reach, a higher one's.
+    low_end = h.rank_ == 0 ? 0 : first_at(own_lo > ~std::uint64_t{0} - reach ? ~std::uint64_t{0} : own_lo + reach);
+    high_begin = std::max(low_end, own_hi_bounded ? first_at(own_hi < reach ? 0 : own_hi - reach) : keys.size());
   }
   bool any = false;
   std::uint64_t previous = 0;
-  for (std::size_t i = 0; i < keys.size(); ++i) {
-    if (i == skip_begin && skip_end > skip_begin) {
-      i = skip_end - 1;
-      continue;
-    }
-    const std::uint64_t cell = frame.cell_of(keys[i]);
-    if (any && cell == previous) continue;
+  const auto look_at = [&](std::uint64_t key) {
+    const std::uint64_t cell = frame.cell_of(key);
+    if (any && cell == previous) return;
     any = true;
     previous = cell;
     const NeighbourBox box = neighbour_box(frame, cell);
     const std::uint64_t first_key = cell_key(frame, box.lo[0], box.lo[1], box.lo[2]) << shift;
     const std::uint64_t last_key = (cell_key(frame, box.hi[0], box.hi[1], box.hi[2]) << shift) | low;
-    if (first_key >= own_lo && (!own_hi_bounded || last_key < own_hi)) continue;
+    if (first_key >= own_lo && (!own_hi_bounded || last_key < own_hi)) return;
     for_each_cell_in(frame, box, [&](std::uint64_t near) {
       const std::uint64_t lo = near << shift, hi = lo | low;
       const int from = owner_of(lo, cut_keys), to = owner_of(hi, cut_keys);
       for (int o = from; o <= to; ++o)
         if (o != h.rank_) want[static_cast<std::size_t>(o)].push_back(near);
     });
-  }
+  };
+  for (std::size_t i = 0; i < low_end; ++i) look_at(keys[i]);
+  for (std::size_t i = high_begin; i < keys.size(); ++i) look_at(keys[i]);
   std::vector<Bytes> requests(ranks);
   for (std::size_t o = 0; o < ranks; ++o) {
     std::sort(want[o].begin(), want[o].end());

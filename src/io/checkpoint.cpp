@@ -1,7 +1,6 @@
 #include "swirl/io/checkpoint.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <cstring>
 #include <limits>
@@ -25,15 +24,8 @@ constexpr std::string_view kMagic = "SWIRLCKP";
 constexpr std::uint32_t kMaxName = 256, kMaxFields = 64, kMaxValues = 64;
 constexpr std::uint64_t kMaxParticles = std::uint64_t{1} << 31;
 
-// Checkpoint appends until an injected failure (io/write_faults.hpp); 0: none.
-std::atomic<int> injected_append_fault_in{0};
-
-bool injected_append_fault_now() {
-  int left = injected_append_fault_in.load();
-  while (left > 0 && !injected_append_fault_in.compare_exchange_weak(left, left - 1)) {
-  }
-  return left == 1;
-}
+// The append a test asked to fail (io/write_faults.hpp).
+detail::InjectedFault injected_append_fault;
 
 constexpr std::uint64_t kFnvOffset = 0xcbf29ce484222325u;
 
@@ -237,7 +229,7 @@ CheckpointLayout CheckpointLayout::of(const ParticleSet<Real>& particles) {
 
 CheckpointWriter::CheckpointWriter(const std::filesystem::path& path, const CheckpointHeader& header,
                                    const CheckpointLayout& layout, const CheckpointValues& values)
-    : file_(path), path_(path), hash_(kFnvOffset) {
+    : file_(path), hash_(kFnvOffset) {
   if (header.real_bytes != 4 && header.real_bytes != 8)
     throw std::invalid_argument("checkpoint writer: reals of 4 or 8 bytes");
   std::uint64_t arrays = 0;
@@ -274,8 +266,8 @@ void CheckpointWriter::append(std::string_view data) {
   hash_ = fnv1a(data, hash_);
   file_.append(data);
   appended_ += data.size();
-  if (injected_append_fault_now())  // a test's (io/write_faults.hpp): as a full disk would refuse
-    throw IoError(fmt::format("{}: write failed: no space left on device (injected by a test)", path_.string()));
+  if (injected_append_fault.now())  // a test's (io/write_faults.hpp): as a full disk would refuse
+    throw IoError(fmt::format("{}: write failed: no space left on device (injected by a test)", file_.path().string()));
 }
 
 void CheckpointWriter::finish() {
@@ -345,7 +337,7 @@ template CheckpointHeader parse_checkpoint<double>(std::string_view, std::string
                                                    CheckpointValues&);
 
 namespace testing {
-void fail_checkpoint_append(int n) { injected_append_fault_in.store(n > 0 ? n : 0); }
+void fail_checkpoint_append(int n) { injected_append_fault.arm(n); }
 }  // namespace testing
 
 }  // namespace swirl::io

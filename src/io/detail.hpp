@@ -1,7 +1,9 @@
 // Internal helpers of the io module: a minimal XML tag
-// scanner for the files this module writes, and strict number parsing.
+// scanner for the files this module writes, strict number parsing, and the
+// countdown behind the tests' injected write failures (io/write_faults.hpp).
 #pragma once
 
+#include <atomic>
 #include <charconv>
 #include <cstddef>
 #include <filesystem>
@@ -14,6 +16,23 @@
 #include <vector>
 
 namespace swirl::io::detail {
+
+// The n-th of a writer's operations from arm(n) on is to fail (1-based; 0:
+// none). now() counts one operation and says whether it is that one.
+// Thread-safe; per process.
+class InjectedFault {
+ public:
+  void arm(int n) { left_.store(n > 0 ? n : 0); }
+  bool now() {
+    int left = left_.load();
+    while (left > 0 && !left_.compare_exchange_weak(left, left - 1)) {
+    }
+    return left == 1;
+  }
+
+ private:
+  std::atomic<int> left_{0};
+};
 
 // A parse error; readers rethrow it as IoError prefixed with the file name.
 struct Malformed : std::runtime_error {

@@ -8,7 +8,6 @@
 #include <hdf5.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <exception>
@@ -21,6 +20,7 @@
 
 #include <fmt/format.h>
 
+#include "detail.hpp"
 #include "swirl/io/atomic_file.hpp"
 #include "swirl/io/read_file.hpp"
 #include "swirl/io/write_faults.hpp"
@@ -71,16 +71,8 @@ void silence_hdf5() {
 
 // ---- writing -----------------------------------------------------------------
 
-// Dataset writes until an injected failure (io/write_faults.hpp); 0: none.
-std::atomic<int> injected_fault_in{0};
-
-// Whether this dataset write is the one a test asked to fail.
-bool injected_fault_now() {
-  int left = injected_fault_in.load();
-  while (left > 0 && !injected_fault_in.compare_exchange_weak(left, left - 1)) {
-  }
-  return left == 1;
-}
+// The dataset write a test asked to fail (io/write_faults.hpp).
+detail::InjectedFault injected_write_fault;
 
 struct Writer {
   fs::path path;  // the file asked for (errors name it, not a temporary one)
@@ -161,7 +153,7 @@ struct Writer {
         for (int c = 0; c < columns; ++c) values[i * std::size_t(columns) + std::size_t(c)] = fill(i, c);
       if (!transfer.valid()) {
         const herr_t status = H5Dwrite(set->get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data());
-        check(injected_fault_now() ? herr_t(-1) : status, name, 0);
+        check(injected_write_fault.now() ? herr_t(-1) : status, name, 0);
         return;
       }
       // This rank's hyperslab, collectively (a rank without rows selects none).
@@ -175,7 +167,7 @@ struct Writer {
         check(H5Sselect_none(memory.get()), name, 0);
       }
       const herr_t status = H5Dwrite(set->get(), type, memory.get(), file_space.get(), transfer.get(), values.data());
-      check(injected_fault_now() ? herr_t(-1) : status, name, 0);
+      check(injected_write_fault.now() ? herr_t(-1) : status, name, 0);
     });
   }
 
@@ -667,7 +659,7 @@ SnapshotLayout read_snapshot_layout(const fs::path& path, std::optional<int> par
 }
 
 namespace testing {
-void fail_snapshot_dataset_write(int n) { injected_fault_in.store(n > 0 ? n : 0); }
+void fail_snapshot_dataset_write(int n) { injected_write_fault.arm(n); }
 }  // namespace testing
 
 }  // namespace swirl::io

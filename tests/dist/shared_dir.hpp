@@ -1,16 +1,21 @@
 // Test helpers of the writers that the ranks use together
 // (snapshot_on_ranks_test, checkpoint_on_ranks_test): one temporary folder
-// for every rank, and the cuts of a set into the ranks' shares.
+// for every rank, the cuts of a set into the ranks' shares, and the checks
+// after a write that must fail on every rank and keep the file it replaces.
 #pragma once
+
+#include <gtest/gtest.h>
 
 #include <cstddef>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "io/io_test_util.hpp"
 #include "swirl/dist/communicator.hpp"
+#include "swirl/io/atomic_file.hpp"
 
 namespace swirl::io::test {
 
@@ -44,6 +49,28 @@ inline std::size_t regular_files(const std::filesystem::path& dir) {
   std::size_t files = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
   return files;
+}
+
+inline constexpr std::string_view kOldFile = "the old file";
+
+// Collective: rank 0 puts kOldFile at dir/name for a write to replace.
+inline void place_old_file(const dist::Communicator& comm, const SharedDir& dir, const std::string& name) {
+  if (comm.is_root()) write_file_atomic(dir / name, kOldFile);
+  comm.barrier();
+}
+
+// Collective, after a write over place_old_file's that failed with `said`:
+// every rank has the same words, and the folder holds the old file alone
+// (unchanged, no temporary file beside it).
+inline void expect_failed_everywhere_and_kept(const dist::Communicator& comm, const SharedDir& dir,
+                                              const std::string& said, const std::string& name) {
+  EXPECT_NE(said.rfind("(n", 0), 0u) << said;  // io_error_of's "(no exception)" or "(not an IoError) ..."
+  EXPECT_EQ(comm.first_text(comm.is_root() ? said : std::string()), said);
+  if (comm.is_root()) {
+    EXPECT_EQ(slurp(dir / name), kOldFile);
+    EXPECT_EQ(regular_files(dir.path()), 1u) << "a temporary file was left";
+  }
+  comm.barrier();
 }
 
 }  // namespace swirl::io::test

@@ -8,8 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
-#include <filesystem>
-#include <memory>
 #include <numeric>
 #include <string>
 #include <vector>
@@ -17,14 +15,11 @@
 #include "dist/shared_dir.hpp"
 #include "io/io_test_util.hpp"
 #include "swirl/dist/snapshot_on_ranks.hpp"
-#include "swirl/io/atomic_file.hpp"
 #include "swirl/io/snapshot.hpp"
 #include "swirl/io/write_faults.hpp"
 
 namespace swirl::io {
 namespace {
-
-namespace fs = std::filesystem;
 
 using test::SharedDir;
 
@@ -95,25 +90,15 @@ TEST(SnapshotOnRanks, AWriteFailingOnOneRankAloneFailsOnEveryRankWithoutAHang) {
   const dist::Communicator& comm = dist::Communicator::world();
   SharedDir dir(comm);
   const auto p = test::make_particles<double>(1000);
-  if (comm.is_root()) write_file_atomic(dir / "kept.h5", "the old file");
-  comm.barrier();
+  test::place_old_file(comm, dir, "kept.h5");
   const bool failing = comm.rank() == comm.size() - 1;
   if (failing) testing::fail_snapshot_dataset_write(2);
-  std::string said;
-  try {
-    dist::write_snapshot_on_ranks(comm, dir / "kept.h5", p, SnapshotInfo{});
-  } catch (const IoError& e) {
-    said = e.what();
-  }
+  const std::string said =
+      test::io_error_of([&] { dist::write_snapshot_on_ranks(comm, dir / "kept.h5", p, SnapshotInfo{}); });
   testing::fail_snapshot_dataset_write(0);
   EXPECT_NE(said.find("kept.h5"), std::string::npos) << said;
   EXPECT_NE(said.find("Velocities"), std::string::npos) << said;
-  EXPECT_EQ(comm.first_text(comm.is_root() ? said : std::string()), said);
-  if (comm.is_root()) {
-    EXPECT_EQ(test::slurp(dir / "kept.h5"), "the old file");
-    EXPECT_EQ(test::regular_files(dir.path()), 1u) << "a temporary file was left";
-  }
-  comm.barrier();
+  test::expect_failed_everywhere_and_kept(comm, dir, said, "kept.h5");
   // The next write succeeds.
   dist::write_snapshot_on_ranks(comm, dir / "kept.h5", p, SnapshotInfo{});
   if (comm.is_root()) {
@@ -125,23 +110,13 @@ TEST(SnapshotOnRanks, AFailedWriteFailsOnEveryRankAndKeepsTheOldFile) {
   const dist::Communicator& comm = dist::Communicator::world();
   SharedDir dir(comm);
   const auto p = test::make_particles<double>(100);
-  if (comm.is_root()) write_file_atomic(dir / "kept.h5", "the old file");
-  comm.barrier();
+  test::place_old_file(comm, dir, "kept.h5");
   // A folder that does not exist: the file cannot be created on any rank.
-  std::string said;
-  try {
-    dist::write_snapshot_on_ranks(comm, dir / "missing" / "kept.h5", p, SnapshotInfo{});
-  } catch (const IoError& e) {
-    said = e.what();
-  }
+  const std::string said =
+      test::io_error_of([&] { dist::write_snapshot_on_ranks(comm, dir / "missing" / "kept.h5", p, SnapshotInfo{}); });
   EXPECT_NE(said.find("missing"), std::string::npos) << said;
-  // Every rank has the same words.
-  EXPECT_EQ(comm.first_text(comm.is_root() ? said : std::string()), said);
-  // A written file replaces the old one only whole; the old one stays until then.
-  if (comm.is_root()) {
-    EXPECT_EQ(test::slurp(dir / "kept.h5"), "the old file");
-  }
-  comm.barrier();
+  // Every rank has the same words; a written file replaces the old one only whole.
+  test::expect_failed_everywhere_and_kept(comm, dir, said, "kept.h5");
   dist::write_snapshot_on_ranks(comm, dir / "kept.h5", p, SnapshotInfo{});
   if (comm.is_root()) {
     EXPECT_EQ(read_snapshot(dir / "kept.h5").count, 100u * std::size_t(comm.size()));

@@ -19,19 +19,6 @@ class AtomicFileTest : public ::testing::Test {
   TempDir dir;
 };
 
-// The message of the IoError that `f` throws, or a note that it did not.
-template <class F>
-std::string io_error_of(F&& f) {
-  try {
-    f();
-  } catch (const IoError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    return std::string("(not an IoError) ") + e.what();
-  }
-  return "(no exception)";
-}
-
 TEST_F(AtomicFileTest, WritesAndReplacesContent) {
   const auto path = dir / "out.txt";
   write_file_atomic(path, "first");

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -20,10 +21,25 @@
 #include <fmt/format.h>
 
 #include "swirl/core/particle_set.hpp"
+#include "swirl/io/atomic_file.hpp"
 
 namespace swirl::io::test {
 
 namespace fs = std::filesystem;
+
+// The message of the IoError that `f` throws, or a note that it threw
+// something else or nothing.
+template <class F>
+std::string io_error_of(F&& f) {
+  try {
+    f();
+  } catch (const IoError& e) {
+    return e.what();
+  } catch (const std::exception& e) {
+    return std::string("(not an IoError) ") + e.what();
+  }
+  return "(no exception)";
+}
 
 class TempDir {
  public:

@@ -15,18 +15,6 @@ namespace {
 
 using namespace swirl::io::test;
 
-template <class F>
-std::string io_error_of(F&& f) {
-  try {
-    f();
-  } catch (const IoError& e) {
-    return e.what();
-  } catch (const std::exception& e) {
-    return std::string("(not an IoError) ") + e.what();
-  }
-  return "(no exception)";
-}
-
 TEST(ReadRegularFile, ReadsARegularFileWithinItsLimit) {
   TempDir dir;
   spit(dir / "a.txt", "12345");

@@ -38,6 +38,7 @@ class AtomicFileWriter {
 
   void append(std::string_view bytes);
   void commit(bool sync);
+  const std::filesystem::path& path() const { return path_; }
 
  private:
   std::filesystem::path path_, temporary_;

@@ -108,7 +108,6 @@ class CheckpointWriter {
 
  private:
   AtomicFileWriter file_;
-  std::filesystem::path path_;
   std::uint64_t hash_;
   std::uint64_t expected_ = 0, appended_ = 0;  // data bytes
 };

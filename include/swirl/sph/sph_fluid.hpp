@@ -748,13 +748,12 @@ class SphFluid final : public Solver<Real> {
                         dist::Halo* halo = nullptr) {
     const std::int32_t* kind = kinds(p);
     if (!kind) return false;
-    // Counted at every evaluation: inlets and outlets change the fluid count
-    // (sim/inlets_outlets.hpp), and the solves' average errors divide by it.
-    // On several ranks the sum is a collective between the ghosts' insert and
-    // the density pass, where the ranks' different shares of the insert's work
-    // would wait for each other: it is summed only when the particle count
-    // changed (no rank creates or removes a particle: inlets and outlets do
-    // not run on ranks, and no particle changes kind), and at the first call.
+    // The solves' average errors divide by it. One rank: counted at every
+    // evaluation (inlets and outlets change it, sim/inlets_outlets.hpp).
+    // Several ranks: summed over them only when their particle count changed
+    // (inlets and outlets do not run on ranks, no particle changes kind), as
+    // the sum is a collective between the ghosts' insert and the density
+    // pass, where the ranks' unequal shares of the insert would wait.
     if (!ranks_)
       fluid_count_ = count_fluid(p, own);
     else if (fluid_count_for_ != ranks_->global_count()) {
