@@ -72,7 +72,10 @@ def main():
     results = os.path.abspath(a.results)
 
     found = [d for d in sorted(os.listdir(results)) if os.path.isdir(os.path.join(results, d))] if os.path.isdir(results) else []
-    suites = SUITES + [s for s in found if s not in SUITES]
+    # Other folders are suites only when they hold a suite's <name>.md; the
+    # rest (hand-run records such as fmm-scale-2026-12-04/) are data that
+    # the fragments link to.
+    suites = SUITES + [s for s in found if s not in SUITES and os.path.exists(os.path.join(results, s, s + ".md"))]
     fragments = sorted(glob.glob(os.path.join(a.fragments, "*.md")))
 
     out = []

@@ -235,8 +235,12 @@ void node_blocks(std::string_view kernel, std::size_t n, Body&& body) {
 // The walk is cut into at least this many tasks (a fixed number: the tasks,
 // hence the lists, never depend on the thread count).
 constexpr std::size_t kWalkTasks = 256;
-// M2L interactions per chunk (buffer: 2 × coef_count(p + 1) doubles each).
-constexpr std::size_t kM2lChunk = 4096;
+// M2L interactions per chunk (buffer: 2 × coef_count(p + 1) doubles each:
+// 1.4 MB at p = 5, so that the add pass finds it still in cache). With 4096
+// (5.5 MB) the M2L at 2²⁰ particles was bound by memory: 0.57 s on one
+// thread and on two; with 1024 0.32 s on two (docs/performance/gravity-peers.md).
+// The chunking does not change a result: every cell receives its terms in list order.
+constexpr std::size_t kM2lChunk = 1024;
 // The P2P's inner loops run over whole vectors of this many doubles (one
 // AVX-512 or two AVX2 registers): a fixed trip count the compiler vectorizes
 // without a scalar remainder, each lane its own partial sums.
