@@ -14,7 +14,6 @@ template <class Real>
 void write_checkpoint_on_ranks(const Communicator& comm, const std::filesystem::path& path,
                                const ParticleSet<Real>& own, const io::CheckpointHeader& header,
                                const io::CheckpointValues& values) {
-  using Int = typename ParticleSet<Real>::int_type;
   if (!comm.distributed()) {
     io::write_checkpoint(path, own, header, values);
     return;
@@ -38,7 +37,7 @@ void write_checkpoint_on_ranks(const Communicator& comm, const std::filesystem::
   // Every array in the file's order, each rank's share in rank order; after a
   // failed append rank 0 still takes the arrays (the others are in the gather).
   Bytes mine;
-  const auto hand = [&](const auto* data, std::size_t bytes) {
+  io::for_each_checkpoint_array(own, [&](const void* data, std::size_t bytes) {
     mine.resize(bytes);
     if (bytes > 0) std::memcpy(mine.data(), data, bytes);
     const std::vector<Bytes> shares = comm.gather_to_root(mine);
@@ -50,11 +49,7 @@ void write_checkpoint_on_ranks(const Communicator& comm, const std::filesystem::
       error = e.what();
       out.reset();  // the temporary file is removed
     }
-  };
-  for (const auto& f : own.fields())
-    for (int c = 0; c < f.components; ++c) hand(f.data[c], own.size() * sizeof(Real));
-  for (const auto& f : own.int_fields()) hand(f.data[0], own.size() * sizeof(Int));
-  hand(own.id.data(), own.size() * sizeof(std::uint64_t));
+  });
   if (out) {
     try {
       out->finish();

@@ -32,34 +32,6 @@ fs::path unique_sibling(const fs::path& path, std::string_view tag) {
          fmt::format(".{}.{}.{}.{}", path.filename().string(), tag, ::getpid(), g_counter.fetch_add(1));
 }
 
-// Owns a file descriptor and the temporary file behind it until release():
-// every early exit (throw) closes the descriptor and removes the file.
-class TempFile {
- public:
-  explicit TempFile(fs::path p) : path_(std::move(p)) {}
-  TempFile(const TempFile&) = delete;
-  TempFile& operator=(const TempFile&) = delete;
-  ~TempFile() {
-    if (fd_ >= 0) ::close(fd_);
-    if (!released_) ::unlink(path_.c_str());
-  }
-
-  int open() { return fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666); }
-  int close() {
-    int fd = fd_;
-    fd_ = -1;  // close() releases the descriptor even when it reports an error
-    return ::close(fd);
-  }
-  void release() { released_ = true; }
-  int fd() const { return fd_; }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-  int fd_ = -1;
-  bool released_ = false;
-};
-
 void sync_directory(const fs::path& path) {
   fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
   int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
@@ -74,29 +46,33 @@ void sync_directory(const fs::path& path) {
 
 }  // namespace
 
-AtomicFileWriter::AtomicFileWriter(const fs::path& path) : path_(path) {
-  if (path.filename().empty()) throw IoError(fmt::format("{}: not a file name", path.string()));
-  temporary_ = unique_sibling(path, "tmp");
-  fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd_ < 0) fail(path, fmt::format("cannot create temporary file {}", temporary_.string()), errno);
-}
-
-AtomicFileWriter::~AtomicFileWriter() {
+namespace detail {
+TempFile::~TempFile() {
   if (fd_ >= 0) ::close(fd_);
-  if (!committed_) ::unlink(temporary_.c_str());
+  if (!released_) ::unlink(path_.c_str());
+}
+int TempFile::open() { return fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666); }
+int TempFile::close() {
+  const int fd = fd_;
+  fd_ = -1;  // close() releases the descriptor even when it reports an error
+  return ::close(fd);
+}
+}  // namespace detail
+
+AtomicFileWriter::AtomicFileWriter(const fs::path& path) : path_(path), temporary_(temporary_sibling(path)) {
+  if (temporary_.open() < 0) fail(path, fmt::format("cannot create temporary file {}", temporary_.path().string()), errno);
 }
 
 void AtomicFileWriter::append(std::string_view bytes) {
-  if (fd_ < 0) throw IoError(fmt::format("{}: written after it was committed or failed", path_.string()));
+  if (temporary_.fd() < 0) throw IoError(fmt::format("{}: written after it was committed or failed", path_.string()));
   const char* p = bytes.data();
   std::size_t left = bytes.size();
   while (left > 0) {
-    ssize_t n = ::write(fd_, p, left);
+    ssize_t n = ::write(temporary_.fd(), p, left);
     if (n < 0) {
       if (errno == EINTR) continue;
       const int err = errno;
-      ::close(fd_);
-      fd_ = -1;
+      temporary_.close();
       fail(path_, "write failed", err);
     }
     p += n;
@@ -105,14 +81,13 @@ void AtomicFileWriter::append(std::string_view bytes) {
 }
 
 void AtomicFileWriter::commit(bool sync) {
-  if (fd_ < 0) throw IoError(fmt::format("{}: committed twice or after a failed write", path_.string()));
-  if (sync && ::fsync(fd_) != 0) fail(path_, "fsync failed", errno);
+  if (temporary_.fd() < 0) throw IoError(fmt::format("{}: committed twice or after a failed write", path_.string()));
+  if (sync && ::fsync(temporary_.fd()) != 0) fail(path_, "fsync failed", errno);
   // Delayed-allocation file systems may report ENOSPC or EIO only here.
-  const int fd = fd_;
-  fd_ = -1;  // close() releases the descriptor even when it reports an error
-  if (::close(fd) != 0) fail(path_, "close failed", errno);
-  if (::rename(temporary_.c_str(), path_.c_str()) != 0) fail(path_, "cannot rename the temporary file over it", errno);
-  committed_ = true;
+  if (temporary_.close() != 0) fail(path_, "close failed", errno);
+  if (::rename(temporary_.path().c_str(), path_.c_str()) != 0)
+    fail(path_, "cannot rename the temporary file over it", errno);
+  temporary_.release();
   if (sync) sync_directory(path_);
 }
 
@@ -128,7 +103,7 @@ fs::path temporary_sibling(const fs::path& path) {
 }
 
 void publish_file_atomic(const fs::path& temporary, const fs::path& path) {
-  TempFile tmp(temporary);  // removed if the rename fails
+  detail::TempFile tmp(temporary);  // removed if the rename fails
   if (::rename(temporary.c_str(), path.c_str()) != 0) fail(path, "cannot rename the temporary file over it", errno);
   tmp.release();
 }
@@ -140,7 +115,7 @@ void ensure_writable_directory(const fs::path& dir, std::uintmax_t bytes_needed)
 
   // Permission bits do not tell the whole story (read-only mounts, ACLs, root),
   // so the only reliable test is to create a file.
-  TempFile probe(unique_sibling(dir / "probe", "writable"));
+  detail::TempFile probe(unique_sibling(dir / "probe", "writable"));
   if (probe.open() < 0) fail(dir, "directory is not writable", errno);
   if (probe.close() != 0) fail(dir, "directory is not writable (close failed)", errno);
   const auto space = fs::space(dir, ec);
@@ -159,7 +134,7 @@ void ensure_writable_file(const fs::path& path) {
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
   if (!fs::is_directory(dir, ec))
     throw IoError(fmt::format("{}: cannot be written: the folder {} does not exist", path.string(), dir.string()));
-  TempFile probe(unique_sibling(path, "probe"));
+  detail::TempFile probe(unique_sibling(path, "probe"));
   if (probe.open() < 0) fail(path, "cannot be written", errno);
   if (probe.close() != 0) fail(path, "cannot be written (close failed)", errno);
 }

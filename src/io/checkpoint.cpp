@@ -281,18 +281,13 @@ void CheckpointWriter::finish() {
 template <class Real>
 void write_checkpoint(const std::filesystem::path& path, const ParticleSet<Real>& particles,
                       const CheckpointHeader& header, const CheckpointValues& values) {
-  using Int = typename ParticleSet<Real>::int_type;
   CheckpointHeader h = header;
   h.real_bytes = sizeof(Real);
   h.particles = particles.size();
   CheckpointWriter out(path, h, CheckpointLayout::of(particles), values);
-  const auto array = [&](const auto* data, std::size_t bytes) {
-    out.append(std::string_view(reinterpret_cast<const char*>(data), bytes));
-  };
-  for (const auto& f : particles.fields())
-    for (int c = 0; c < f.components; ++c) array(f.data[c], particles.size() * sizeof(Real));
-  for (const auto& f : particles.int_fields()) array(f.data[0], particles.size() * sizeof(Int));
-  array(particles.id.data(), particles.size() * sizeof(std::uint64_t));
+  for_each_checkpoint_array(particles, [&](const void* data, std::size_t bytes) {
+    out.append(std::string_view(static_cast<const char*>(data), bytes));
+  });
   out.finish();
 }
 

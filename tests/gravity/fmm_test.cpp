@@ -189,7 +189,7 @@ TYPED_TEST(FmmTest, OneTwoAndThreeThreadsGiveTheSameBits) {
     parallel::set_thread_count(1);
     FmmStats st;
     const GravityField<Real> one = fmm_field(p, 4, 0.5, 0.01, bucket, &st);
-    ASSERT_GT(st.m2l, 4096u) << "several M2L chunks";
+    ASSERT_GT(st.m2l, 4096u) << "several M2L chunks (of 1024: kM2lChunk in fmm.cpp)";
     ASSERT_GT(st.tasks, 64u);
     for (int threads : {2, 3}) {
       parallel::set_thread_count(threads);

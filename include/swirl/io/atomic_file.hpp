@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 namespace swirl::io {
 
@@ -29,21 +30,40 @@ void write_file_atomic(const std::filesystem::path& path, std::string_view bytes
 // write_file_atomic() does. Destroyed without commit() (an exception, a
 // failed append), it removes the temporary file and `path` stays as it was.
 // Every failure throws IoError naming `path`.
+namespace detail {
+// Owns a temporary file, its descriptor and its name, until release(): every
+// early exit (a throw) closes the descriptor and removes the file.
+class TempFile {
+ public:
+  explicit TempFile(std::filesystem::path path) : path_(std::move(path)) {}
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  ~TempFile();
+
+  int open();   // creates it (never an existing file): the descriptor, or −1 with errno
+  int close();  // 0, or −1 with errno; the descriptor is released either way
+  void release() { released_ = true; }
+  int fd() const { return fd_; }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+  int fd_ = -1;
+  bool released_ = false;
+};
+}  // namespace detail
+
 class AtomicFileWriter {
  public:
   explicit AtomicFileWriter(const std::filesystem::path& path);
-  AtomicFileWriter(const AtomicFileWriter&) = delete;
-  AtomicFileWriter& operator=(const AtomicFileWriter&) = delete;
-  ~AtomicFileWriter();
 
   void append(std::string_view bytes);
   void commit(bool sync);
   const std::filesystem::path& path() const { return path_; }
 
  private:
-  std::filesystem::path path_, temporary_;
-  int fd_ = -1;
-  bool committed_ = false;
+  std::filesystem::path path_;
+  detail::TempFile temporary_;  // its descriptor is closed after commit() or a failed write
 };
 
 // The same for a file that something else fills (the ranks of a parallel

@@ -88,6 +88,18 @@ struct CheckpointLayout {
   static CheckpointLayout of(const ParticleSet<Real>& particles);
 };
 
+// Calls f(data, bytes) for every array of `particles` in the file's order (the
+// order of CheckpointLayout, then the ids): what a CheckpointWriter is handed.
+template <class Real, class F>
+void for_each_checkpoint_array(const ParticleSet<Real>& particles, F&& f) {
+  using Int = typename ParticleSet<Real>::int_type;
+  const std::size_t n = particles.size();
+  for (const auto& field : particles.fields())
+    for (int c = 0; c < field.components; ++c) f(static_cast<const void*>(field.data[c]), n * sizeof(Real));
+  for (const auto& field : particles.int_fields()) f(static_cast<const void*>(field.data[0]), n * sizeof(Int));
+  f(static_cast<const void*>(particles.id.data()), n * sizeof(std::uint64_t));
+}
+
 // Writes one checkpoint piece by piece, so that neither the file nor the whole
 // particle set needs to be in memory at once (on several ranks rank 0 writes
 // one field of every rank at a time: dist/checkpoint_on_ranks.hpp). The
