@@ -1010,9 +1010,8 @@ std::string distributed_support_of(const scene::Scene& scene) {
     const std::string no = sph::SphFluid<Real>(*scene.sph).distributed_support();
     if (!no.empty()) return no;
   }
-  if (scene.has_inlets_or_outlets()) return "inlets and outlets ([[inlets]], [[outlets]]: a particle count that changes)";
   // Boundary particles (box.walls = "particles", obstacles, moving ones),
-  // probes and obstacle forces run on ranks too.
+  // probes, obstacle forces, inlets and outlets run on ranks too.
   return {};
 }
 

@@ -154,6 +154,18 @@ class RankOrder {
     }
   }
 
+  // After particles were removed from or added to p (sim/inlets_outlets.hpp)
+  // with the concatenation in rank order still the one-rank memory order:
+  // where each rank's range starts and the count, and the next update()
+  // sorts (as ParticleOrder::touch()). Collective.
+  void particles_changed(const ParticleSet<Real>& p) {
+    first_ = comm_->exclusive_prefix_sum(p.size());
+    global_count_ = comm_->sum(std::uint64_t{p.size()});
+    keys_.clear();
+    valid_ = false;
+    ++epoch_;
+  }
+
   // Brings the particles into the global order when the request needs it
   // (see the header). Returns true when it sorted (on every rank alike).
   // Throws spatial::NonFinitePosition on every rank when any rank holds a

@@ -25,7 +25,11 @@
 // exactly where the uninterrupted one would have. Acts first among the
 // observers, so frames, diagnostics and checkpoints see the changed set.
 // Everything here is serial and in double: the same bits for any thread count.
-// One rank only (sim/run.hpp refuses inlets and outlets on several ranks).
+// Several ranks: every rank decides the same layers (a function of t), each
+// removes its own leaving particles, and only the last rank appends the new
+// ones, at the end of the global order as one rank appends them; whether
+// anything changes, the largest id and the count removed are decided over
+// all ranks. The same bits for any rank count.
 #pragma once
 
 #include <algorithm>
@@ -40,6 +44,7 @@
 
 #include "swirl/core/named_values.hpp"
 #include "swirl/core/particle_kind.hpp"
+#include "swirl/dist/communicator.hpp"
 #include "swirl/scene/scene.hpp"
 #include "swirl/sim/observer.hpp"
 
@@ -73,9 +78,12 @@ class InletsAndOutlets final : public Observer<Real> {
 
   void on_start(Simulation<Real>& sim, bool resumed) override {
     if (resumed && have_next_id_) return;
-    // A fresh run (or a state without the value): one past the largest id.
+    // A fresh run (or a state without the value): one past the largest id (of all ranks).
     const auto& ids = sim.particles().id;
-    next_id_ = ids.empty() ? 0 : *std::max_element(ids.begin(), ids.end()) + 1;
+    std::uint64_t next = ids.empty() ? 0 : *std::max_element(ids.begin(), ids.end()) + 1;
+    if (const dist::Communicator* comm = communicator(sim))
+      for (const std::uint64_t n : comm->all_gather(next)) next = std::max(next, n);
+    next_id_ = next;
   }
 
   void on_step(Simulation<Real>& sim) override {
@@ -93,6 +101,8 @@ class InletsAndOutlets final : public Observer<Real> {
     };
     bool any_leaves = false;
     for (std::size_t i = 0; i < p.size() && !any_leaves && !outlets_.empty(); ++i) any_leaves = leaves(i);
+    const dist::Communicator* comm = communicator(sim);
+    if (comm && !outlets_.empty()) any_leaves = comm->sum(std::uint64_t{any_leaves}) != 0;
     // What enters: the layers due by t.
     struct Entering {
       Vec3d x, v;
@@ -112,8 +122,16 @@ class InletsAndOutlets final : public Observer<Real> {
       }
     }
     if (!any_leaves && entering.empty()) return;
+    // On ranks the new particles are the last rank's (the end of the global order).
+    const bool appends = !comm || comm->rank() + 1 == comm->size();
     sim.change_particles([&](ParticleSet<Real>& q) {
-      removed_ += q.remove_if(leaves);
+      const std::uint64_t removed = q.remove_if(leaves);
+      removed_ += comm && any_leaves ? comm->sum(removed) : removed;
+      if (!appends) {
+        next_id_ += entering.size();
+        emitted_ += entering.size();
+        return;
+      }
       const std::size_t first = q.size();
       q.resize(first + entering.size());
       for (std::size_t j = 0; j < entering.size(); ++j) {
@@ -153,6 +171,11 @@ class InletsAndOutlets final : public Observer<Real> {
   std::size_t layer_size(std::size_t inlet) const { return patterns_[inlet].size(); }
 
  private:
+  // The run's ranks when there are several, else null.
+  static const dist::Communicator* communicator(const Simulation<Real>& sim) {
+    return sim.ranks() && sim.ranks()->comm().distributed() ? &sim.ranks()->comm() : nullptr;
+  }
+
   std::vector<scene::Inlet> inlets_;
   std::vector<scene::Outlet> outlets_;
   std::vector<std::vector<Vec3d>> patterns_;

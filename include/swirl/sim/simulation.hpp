@@ -267,13 +267,17 @@ class Simulation {
   // current positions (new particles get their acceleration, the fluid its
   // density and DFSPH factor; a resumed run re-evaluates the same state), and
   // the limits follow the new state. Serial edits and the usual passes: the
-  // same bits for any thread count. One rank only.
+  // same bits for any thread count. On several ranks every rank calls it (the
+  // edit of its own particles; new ones only on the last rank, so that the
+  // concatenation stays the one-rank memory order): the same bits for any
+  // rank count.
   template <class Edit>
   void change_particles(Edit&& edit) {
     if (!started_) throw std::logic_error("Simulation::change_particles() before start()");
-    if (ranks_) throw std::logic_error("Simulation::change_particles() on several ranks: a changing count is not distributed");
     edit(particles_);
     order_.touch();
+    if (ranks_) ranks_->particles_changed(particles_);
+    gathered_valid_ = false;
     Evaluation forces(*this);
     stepper_->start(particles_, forces, time(), settings_.block_size);
     rescan();

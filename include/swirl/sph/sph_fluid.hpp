@@ -751,7 +751,9 @@ class SphFluid final : public Solver<Real> {
     // The solves' average errors divide by it. One rank: counted at every
     // evaluation (inlets and outlets change it, sim/inlets_outlets.hpp).
     // Several ranks: summed over them only when their particle count changed
-    // (inlets and outlets do not run on ranks, no particle changes kind), as
+    // (no particle changes kind and inlets and outlets add and remove only
+    // fluid: the boundary count is fixed, so the fluid count follows the global
+    // count), as
     // the sum is a collective between the ghosts' insert and the density
     // pass, where the ranks' unequal shares of the insert would wait.
     if (!ranks_)
