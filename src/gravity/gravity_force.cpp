@@ -53,7 +53,7 @@ bool GravityForce<Real>::views_order() const {
 
 template <class Real>
 std::string GravityForce<Real>::distributed_support() const {
-  if (settings_.method == Method::Direct) return {};
+  if (settings_.method == Method::Direct || settings_.method == Method::Fmm) return {};  // replicated
   if (settings_.method != Method::BarnesHut) return fmt::format("nbody.method = \"{}\"", to_string(settings_.method));
   if (!views_order()) return "a Barnes-Hut tree other than the linear octree over the particle order";
   if (settings_.walk != Walk::Group) return "nbody.walk = \"particle\"";
@@ -86,16 +86,13 @@ spatial::OrderRequest GravityForce<Real>::order_request() const {
 
 namespace {
 
-// The direct sum on several ranks: every rank gathers every rank's positions
-// and masses in rank order — the one-rank memory order (dist/rank_order.hpp)
-// — and sums over all of them for its own active particles with the one-rank
-// direct_sum(), whose sum for a particle depends only on the whole set's
-// order: the one-rank bits. O(N) memory per rank, as the O(N²) method's sizes
-// allow. Fills own (one entry per own particle) and returns the global count
-// of active particles. Collective.
+// The whole set's positions and masses on every rank, in rank order — the
+// one-rank memory order (dist/rank_order.hpp) — and, when keys is given, the
+// whole order's keys (each rank's keys() in rank order: the one-rank keys).
+// O(N) memory per rank. Collective.
 template <class Real>
-std::uint64_t direct_sum_on_ranks(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p, Real softening,
-                                  std::size_t block_size, const ActiveSet& active, GravityField<Real>& own) {
+ParticleSet<Real> gather_whole(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p, const char* what,
+                               std::vector<std::uint64_t>* keys = nullptr) {
   const dist::Communicator& comm = order.comm();
   const std::size_t n = p.size();
   std::vector<Real> mine;
@@ -105,15 +102,45 @@ std::uint64_t direct_sum_on_ranks(const dist::RankOrder<Real>& order, const Part
   std::size_t at = 0;
   for (const dist::Bytes& b : comm.all_gather(dist::to_bytes(std::span<const Real>(mine)))) {
     std::vector<Real> theirs;
-    dist::append_values(b, theirs, "direct sum on ranks");
+    dist::append_values(b, theirs, what);
     const std::size_t count = theirs.size() / 4;
     if (theirs.size() % 4 != 0 || at + count > all.size())
-      throw std::runtime_error("direct sum on ranks: a rank sent a partial set");
+      throw std::runtime_error(std::string(what) + ": a rank sent a partial set");
     for (int a = 0; a < 3; ++a) std::copy_n(theirs.data() + a * count, count, all.position[a].data() + at);
     std::copy_n(theirs.data() + 3 * count, count, all.mass.data() + at);
     at += count;
   }
-  if (at != all.size()) throw std::runtime_error("direct sum on ranks: the ranks hold another particle count");
+  if (at != all.size()) throw std::runtime_error(std::string(what) + ": the ranks hold another particle count");
+  if (keys) {
+    keys->clear();
+    keys->reserve(all.size());
+    for (const dist::Bytes& b : comm.all_gather(dist::to_bytes(order.keys()))) dist::append_values(b, *keys, what);
+    if (keys->size() != all.size()) throw std::runtime_error(std::string(what) + ": the ranks hold another key count");
+  }
+  return all;
+}
+
+// This rank's own particles' entries of the whole set's field.
+template <class Real>
+void keep_own(const GravityField<Real>& whole, std::size_t first, std::size_t n, GravityField<Real>& own) {
+  own.resize(n);
+  for (int a = 0; a < 3; ++a)
+    std::copy_n(whole.acceleration[a].data() + first, n, own.acceleration[a].data());
+  std::copy_n(whole.potential.data() + first, n, own.potential.data());
+}
+
+// The direct sum on several ranks: every rank gathers the whole set
+// (gather_whole) and sums over all of it for its own active particles with
+// the one-rank direct_sum(), whose sum for a particle depends only on the
+// whole set's order: the one-rank bits. O(N) memory per rank, as the O(N²)
+// method's sizes allow. Fills own (one entry per own particle) and returns
+// the global count of active particles. Collective.
+template <class Real>
+std::uint64_t direct_sum_on_ranks(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p, Real softening,
+                                  std::size_t block_size, const ActiveSet& active, GravityField<Real>& own) {
+  const dist::Communicator& comm = order.comm();
+  const std::size_t n = p.size();
+  ParticleSet<Real> all = gather_whole(order, p, "direct sum on ranks");
   // Only this rank's own active particles are summed.
   std::vector<std::int32_t> flags(all.size(), 0);
   const std::size_t first = order.first_global_index();
@@ -124,11 +151,7 @@ std::uint64_t direct_sum_on_ranks(const dist::RankOrder<Real>& order, const Part
   }
   GravityField<Real> field;
   direct_sum(all, softening, block_size, field, ActiveSet{flags.data(), 1});
-  own.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int a = 0; a < 3; ++a) own.acceleration[a][i] = field.acceleration[a][first + i];
-    own.potential[i] = field.potential[first + i];
-  }
+  keep_own(field, first, n, own);
   return comm.sum(active_count);
 }
 
@@ -142,7 +165,7 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     stats_.walked = direct_sum_on_ranks(*ctx.ranks, p, Real(settings_.softening), ctx.block_size, ctx.active, field_);
     stats_.mean_nodes_visited = double(ctx.ranks->global_count() - 1);
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  } else if (ctx.ranks) {
+  } else if (ctx.ranks && settings_.method != Method::Fmm) {
     // The locally essential tree over the global order (essential_tree.hpp):
     // every particle's field is the one-rank group walk's, bit for bit.
     if (const std::string no = distributed_support(); !no.empty())
@@ -186,9 +209,27 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   } else if (settings_.method == Method::Fmm) {
     // Every particle, whatever the active set (fmm.hpp); the loop below writes the active ones.
-    const auto* order = ctx.order;
-    if (views_order() && order && order->valid() && order->frame().curve == spatial::CellOrder::Morton &&
-        order->keys().size() == p.size()) {
+    std::size_t whole_count = p.size();
+    if (ctx.ranks) {
+      // Several ranks, replicated: every rank gathers the whole set (and the
+      // order's keys) in the one-rank memory order and runs the one-rank FMM
+      // over all of it, keeping its own particles' field: the one-rank bits;
+      // no gain from the ranks (each computes the whole; its threads share it).
+      const dist::RankOrder<Real>& order = *ctx.ranks;
+      const auto& f = order.frame();
+      const bool sorted = views_order() && order.valid() && f.curve == spatial::CellOrder::Morton;
+      std::vector<std::uint64_t> keys;
+      const ParticleSet<Real> all = gather_whole(order, p, "the FMM on ranks", sorted ? &keys : nullptr);
+      GravityField<Real> whole;
+      if (sorted)
+        fmm_.compute_sorted(all, keys, f.corner, f.root_side(), whole, ctx.block_size);
+      else
+        fmm_.compute(all, whole, ctx.block_size);
+      keep_own(whole, order.first_global_index(), p.size(), field_);
+      whole_count = all.size();
+    } else if (const auto* order = ctx.order; views_order() && order && order->valid() &&
+                                              order->frame().curve == spatial::CellOrder::Morton &&
+                                              order->keys().size() == p.size()) {
       const auto& f = order->frame();
       fmm_.compute_sorted(p, order->keys(), f.corner, f.root_side(), field_, ctx.block_size);
     } else {
@@ -196,12 +237,12 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     }
     const FmmStats& fs = fmm_.stats();
     stats_ = GravityStats{};
-    const double n = p.empty() ? 1.0 : double(p.size());
+    const double n = whole_count == 0 ? 1.0 : double(whole_count);
     // Per particle: the cell interactions (M2L and P2P cell pairs) it takes part in
     // and the terms evaluated (two per mutual interaction: one for each side).
     stats_.mean_nodes_visited = 2.0 * double(fs.m2l + fs.p2p_cells) / n;
     stats_.mean_interactions = 2.0 * double(fs.m2l + fs.p2p_pairs) / n;
-    stats_.walked = p.size();
+    stats_.walked = whole_count;
     stats_.trees = 1;
     stats_.nodes = fs.nodes;
     stats_.depth = fs.depth;

@@ -78,7 +78,11 @@ Footprint footprint(const scene::Scene& scene, int ranks) {
     const double side = std::cbrt(mine) + 4 * support_in_spacings;
     ghosts = std::min(n - mine, side * side * side - mine);
   }
-  const double imported = scene.nbody ? mine * 2 * 96 : 0;
+  // The direct sum and the FMM are replicated: every rank gathers the whole
+  // set (fields, keys, the field) and the FMM builds its tree over it.
+  double imported = scene.nbody ? mine * 2 * 96 : 0;
+  if (scene.nbody && (scene.nbody->method == gravity::Method::Direct || scene.nbody->method == gravity::Method::Fmm))
+    imported = n * (fields + 8 + 4 * real + (scene.nbody->method == gravity::Method::Fmm ? 2 * 96 : 0));
   const double rank = (mine + ghosts) * (fields + solver) + ghosts * fields + imported + fixed;
   f.memory.assign(static_cast<std::size_t>(ranks), rank);
   // Rank 0 builds the whole set (and the scene's double copy), and gathers

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # `swirl run` on several MPI ranks (issue 19, points 1, 5, 6 and 7): the same
-# scene (SPH, self-gravity by the tree or the direct sum, both; block time
+# scene (SPH, self-gravity by the tree, the direct sum or the FMM, both; block time
 # steps; DFSPH and boundary particles; probes,
 # obstacle forces and moving obstacles; inlets and outlets) on 1 (no mpirun), 2, 3 and 4 ranks
 # gives byte-identical frames (VTK, and HDF5 written through parallel HDF5), diagnostics, probes.csv and checkpoints; a run resumes on another rank count and ends with the one-rank
@@ -159,6 +159,14 @@ for variant in global block; do
   same_files "$out/direct_${variant}_1" "$out/direct_${variant}_$n" "the direct sum ($variant steps) on $n ranks"
 done
 
+# 4a''. The FMM on ranks (replicated: every rank gathers the whole set and
+#       runs the one-rank FMM): a Plummer sphere of 2 000 stars, p = 4, with
+#       block time steps, against one rank as against_one does.
+against_one fmm "the FMM with block steps" "particles_000015.h5 diagnostics.csv checkpoints/checkpoint_000000000030.swc" \
+  "$examples/plummer.toml" --set particles.0.count=2000 --set 'nbody.method="fmm"' --set nbody.fmm_order=4 \
+  --set 'simulation.time_steps="block"' --set simulation.dt=0.0625 --set simulation.max_bin=8 --set simulation.eta=0.2 \
+  --set 'output.format="hdf5"' --set output.interval=0.125
+
 # 4b. Boundary particles and DFSPH (docs/sph.md): the dam break with an
 #     obstacle at a 10 cm spacing (about 800 water and 1 900 boundary
 #     particles: box.walls = "particles" and an obstacle_box), DFSPH in double
@@ -240,9 +248,11 @@ on_ranks 2 run "$scene" "${small[@]}" --set 'sph.neighbour_search="hash"' --step
   fail "the hash search on 2 ranks: the refusal is not printed exactly once"
 [ ! -e "$out/refused" ] || fail "the hash search on 2 ranks: the refused run created its folder"
 cat "$out/stderr"
-on_ranks 2 run "$examples/plummer.toml" --set 'nbody.method="fmm"' --steps 2 --out "$out/refused"
-[ "$status" -eq 2 ] || fail "the FMM on 2 ranks: status $status (want 2)"
-grep -q 'nbody.method = "fmm" does not run on several MPI ranks yet' "$out/stderr" || fail "the FMM on 2 ranks: not said why"
+on_ranks 2 run "$examples/plummer.toml" --set 'nbody.walk="particle"' --steps 2 --out "$out/refused"
+[ "$status" -eq 2 ] || fail "the particle walk on 2 ranks: status $status (want 2)"
+grep -q 'nbody.walk = "particle" does not run on several MPI ranks yet' "$out/stderr" ||
+  fail "the particle walk on 2 ranks: not said why"
+[ ! -e "$out/refused" ] || fail "the particle walk on 2 ranks: the refused run created its folder"
 
 # 7. The folder's lock and files are rank 0's: a second run into a folder
 #    holding another run is refused on every rank with status 2.

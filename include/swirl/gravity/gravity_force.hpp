@@ -33,7 +33,12 @@
 // On several ranks (SolverContext::ranks) the linear octree's group walk
 // runs as the locally essential tree (essential_tree.hpp) over the global
 // order, whose cuts rank_cuts() puts on group boundaries: every particle's
-// field is the one-rank field, bit for bit. Other methods are refused there.
+// field is the one-rank field, bit for bit. The direct sum and the FMM run
+// there replicated: every rank gathers the whole set (positions, masses, the
+// order's keys) in the one-rank memory order, computes the one-rank field of
+// all of it and keeps its own particles' (the one-rank bits; O(N) memory per
+// rank, no gain from the ranks). The paper's schemes and the particle walk
+// are refused there.
 #pragma once
 
 #include <string>
@@ -71,8 +76,9 @@ class GravityForce final : public Solver<Real> {
   // On ranks: each particle's interaction-list length in the last walk.
   void add_rank_costs(std::span<std::uint64_t> costs) const override;
   // Empty when these settings run on several ranks (the linear octree's group
-  // walk, as a view of the order: the locally essential tree; the direct sum,
-  // over the whole set gathered on every rank); otherwise what does not.
+  // walk, as a view of the order: the locally essential tree; the direct sum
+  // and the FMM, replicated over the whole set gathered on every rank);
+  // otherwise what does not.
   std::string distributed_support() const;
 
   ScanNeeds scan_needs() const override { return {false, !(settings_.softening > 0)}; }
