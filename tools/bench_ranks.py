@@ -11,7 +11,8 @@ medians (ranks / threads). Results are the runs' --summary-json files in OUT.
         --set 'sph.method="wcsph"' --set particles.0.spacing=0.004 --set sph.smoothing_length=0.008 \\
         --steps 20 --rounds 3 --out /tmp/ranks
 
-Both codes use the same binary (built with -DSWIRL_MPI=ON). As root, the
+Both codes use the same binary (built with -DSWIRL_MPI=ON); --other BIN adds
+another build's ranks run to every round (two builds compared alternately). As root, the
 OpenMPI variables that allow it are set for mpirun here.
 """
 
@@ -54,6 +55,9 @@ def main() -> int:
     ap.add_argument("--threads", type=int, default=2, help="the machine's cores: T")
     ap.add_argument("--ranks", type=int, default=2, help="R (T/R threads each)")
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--other", action="append", default=[], metavar="BIN",
+                    help="another build's swirl, run as R ranks too in every round (its medians and ratio "
+                         "against the threaded run printed beside): compares two builds alternately")
     ap.add_argument("--out", type=Path, required=True)
     args = ap.parse_args()
 
@@ -63,18 +67,19 @@ def main() -> int:
         env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     sets = [a for s in args.set for a in ("--set", s)]
     per_rank = max(1, args.threads // args.ranks)
-    results = {"threads": [], "ranks": []}
+    others = {f"ranks:{b}": b for b in args.other}
+    results = {"threads": [], "ranks": [], **{m: [] for m in others}}
     for r in range(args.rounds):
-        for mode in ("threads", "ranks"):
-            out = args.out / f"{mode}_{r}"
-            summary = args.out / f"{mode}_{r}.json"
+        for mode in results:
+            out = args.out / f"{mode.replace('/', '_').replace(':', '_')}_{r}"
+            summary = Path(f"{out}.json")
             common = ["run", args.scene, *sets, "--steps", str(args.steps), "--out", str(out), "--overwrite",
                       "--summary-json", str(summary)]
             if mode == "threads":
                 cmd = [args.swirl, *common, "--threads", str(args.threads)]
             else:
-                cmd = [args.mpiexec, "-n", str(args.ranks), "--bind-to", "none", args.swirl, *common,
-                       "--threads", str(per_rank)]
+                cmd = [args.mpiexec, "-n", str(args.ranks), "--bind-to", "none", others.get(mode, args.swirl),
+                       *common, "--threads", str(per_rank)]
             load = os.getloadavg()[0]
             s = run(cmd, summary, env)
             s["load_before"] = load
@@ -91,6 +96,9 @@ def main() -> int:
     steps = {m: statistics.median(steps_only(s) for s in results[m]) for m in results}
     print(f"the steps alone (less the first evaluation, phase start): {steps['threads']:.2f} s against "
           f"{steps['ranks']:.2f} s, ratio {steps['ranks'] / steps['threads']:.3f}")
+    for m in others:
+        print(f"{m}: stepping {med[m]:.2f} s (ratio {med[m] / med['threads']:.3f}), the steps alone "
+              f"{steps[m]:.2f} s (ratio {steps[m] / steps['threads']:.3f})")
     phases = sorted({p for m in results for s in results[m] for p in s.get("phase_seconds", {})})
     print(f"\n| phase | 1 x {args.threads} (s) | {args.ranks} x {per_rank} (s) |\n|---|---:|---:|")
     for p in phases:

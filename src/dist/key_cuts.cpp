@@ -70,7 +70,7 @@ std::vector<std::uint64_t> cost_per_rank(const Communicator& comm, std::span<con
                                          std::span<const std::uint64_t> cut_keys) {
   if (keys.size() != costs.size()) throw std::invalid_argument("cost_per_rank: one cost per key is needed");
   std::vector<std::uint64_t> per_rank(static_cast<std::size_t>(comm.size()), 0);
-  for (std::size_t i = 0; i < keys.size(); ++i) per_rank[static_cast<std::size_t>(owner_of(keys[i], cut_keys))] += costs[i];
+  sum_per_rank(keys, cut_keys, [&](std::size_t i) { return costs[i]; }, per_rank);
   comm.sum(per_rank);
   return per_rank;
 }

@@ -254,5 +254,36 @@ TEST(KeyOrder, MoreRanksThanParticlesLeavesSomeRanksEmpty) {
   }
 }
 
+// owners_of() and sum_per_rank() (the few-cuts comparisons and the binary
+// search beyond kFewCuts) against owner_of() per key, for 0 to 12 cuts with
+// repeated cuts, a cut at 0, cuts at the keys themselves and the "no key
+// above" cut (2^64 - 1).
+TEST(KeyOrder, OwnersAndSumsPerRankAreOwnerOfsForAnyCutCount) {
+  std::vector<std::uint64_t> keys(5000);
+  for (std::size_t i = 0; i < keys.size(); ++i) keys[i] = coarse_key(coordinate(i, 0), coordinate(i, 1), coordinate(i, 2));
+  keys[7] = 0;
+  keys[8] = ~std::uint64_t{0};
+  for (std::size_t cuts = 0; cuts <= 12; ++cuts) {
+    std::vector<std::uint64_t> cut_keys;
+    for (std::size_t c = 0; c < cuts; ++c) cut_keys.push_back(keys[(c * 977) % keys.size()]);
+    if (cuts >= 3) cut_keys[0] = 0, cut_keys[1] = cut_keys[2];
+    if (cuts >= 5) cut_keys.back() = ~std::uint64_t{0};
+    std::sort(cut_keys.begin(), cut_keys.end());
+    std::vector<int> destination(keys.size(), -1);
+    owners_of(keys, cut_keys, destination);
+    std::vector<std::uint64_t> counts(cuts + 1, 0), costs(cuts + 1, 0), want_counts(cuts + 1, 0), want_costs(cuts + 1, 0);
+    sum_per_rank(keys, cut_keys, [](std::size_t) { return std::uint64_t{1}; }, counts);
+    sum_per_rank(keys, cut_keys, [](std::size_t i) { return std::uint64_t{i % 7 + 1}; }, costs);
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const int owner = owner_of(keys[i], cut_keys);
+      ASSERT_EQ(destination[i], owner) << cuts << " cuts, key " << i;
+      ++want_counts[static_cast<std::size_t>(owner)];
+      want_costs[static_cast<std::size_t>(owner)] += i % 7 + 1;
+    }
+    EXPECT_EQ(counts, want_counts) << cuts << " cuts";
+    EXPECT_EQ(costs, want_costs) << cuts << " cuts";
+  }
+}
+
 }  // namespace
 }  // namespace swirl::dist

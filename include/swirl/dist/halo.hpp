@@ -76,24 +76,20 @@
 namespace swirl::dist {
 
 // The frame ParticleOrder::update() would give all the ranks' particles under
-// `request`: the global box (exact min/max over ranks), then
-// ParticleOrder::frame_for. cells_fit as there. Collective; throws
+// `request`: the global box (each rank's exact min/max, ParticleOrder's
+// vectorised pass over blocks of block_size, then the min/max over ranks),
+// then ParticleOrder::frame_for. cells_fit as there. Collective; throws
 // spatial::NonFinitePosition on every rank when any rank holds a non-finite position.
 template <class Real>
 spatial::KeyFrame global_key_frame(const Communicator& comm, const ParticleSet<Real>& p,
-                                   const spatial::OrderRequest& request, bool& cells_fit) {
+                                   const spatial::OrderRequest& request, bool& cells_fit,
+                                   std::size_t block_size = 4096) {
   constexpr double inf = std::numeric_limits<double>::infinity();
+  const auto mine = spatial::ParticleOrder<Real>::local_bounds(p.size(), block_size, p.position.x.data(),
+                                                              p.position.y.data(), p.position.z.data());
   std::array<double, 3> lo{inf, inf, inf}, hi{-inf, -inf, -inf};
-  std::uint64_t counts[2] = {p.size(), 0};  // particles, non-finite positions
-  for (int a = 0; a < 3; ++a) {
-    const Real* v = p.position[a].data();
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const double x = double(v[i]);
-      if (!std::isfinite(x)) ++counts[1];
-      lo[static_cast<std::size_t>(a)] = std::min(lo[static_cast<std::size_t>(a)], x);
-      hi[static_cast<std::size_t>(a)] = std::max(hi[static_cast<std::size_t>(a)], x);
-    }
-  }
+  if (!p.empty()) lo = mine.lo, hi = mine.hi;
+  std::uint64_t counts[2] = {p.size(), mine.finite ? 0u : 1u};  // particles, ranks with a non-finite position
   comm.sum(counts);
   if (counts[1] != 0) throw spatial::NonFinitePosition();
   comm.min(lo);

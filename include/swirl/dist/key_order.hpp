@@ -42,6 +42,52 @@ inline int owner_of(std::uint64_t key, std::span<const std::uint64_t> cut_keys) 
   return static_cast<int>(std::upper_bound(cut_keys.begin(), cut_keys.end(), key) - cut_keys.begin());
 }
 
+// Up to this many cuts, owners_of() and sum_per_rank() compare each key with
+// every cut (branch-free, nothing carried from one particle to the next but
+// a sum in a register); beyond it, a binary search per key. Either gives the
+// same integers: the choice is speed only (once per sort, over every particle).
+inline constexpr std::size_t kFewCuts = 8;
+
+// destination[i] = owner_of(keys[i], cut_keys) for every i.
+inline void owners_of(std::span<const std::uint64_t> keys, std::span<const std::uint64_t> cut_keys,
+                      std::span<int> destination) {
+  if (cut_keys.size() > kFewCuts) {
+    for (std::size_t i = 0; i < keys.size(); ++i) destination[i] = owner_of(keys[i], cut_keys);
+    return;
+  }
+  const std::uint64_t* cut = cut_keys.data();
+  const std::size_t cuts = cut_keys.size();
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    int d = 0;
+    for (std::size_t c = 0; c < cuts; ++c) d += keys[i] >= cut[c] ? 1 : 0;
+    destination[i] = d;
+  }
+}
+
+// per_rank[r] += Σ weight(i) over the keys in rank r's range (per_rank: one
+// entry per rank, cut_keys.size() + 1). With few cuts: for each cut the sum
+// over the keys at or above it, one pass each, and the differences.
+template <class Weight>
+void sum_per_rank(std::span<const std::uint64_t> keys, std::span<const std::uint64_t> cut_keys, Weight&& weight,
+                  std::span<std::uint64_t> per_rank) {
+  const std::size_t n = keys.size(), cuts = cut_keys.size();
+  if (cuts > kFewCuts) {
+    for (std::size_t i = 0; i < n; ++i) per_rank[static_cast<std::size_t>(owner_of(keys[i], cut_keys))] += weight(i);
+    return;
+  }
+  std::uint64_t total = 0;
+  for (std::size_t i = 0; i < n; ++i) total += weight(i);
+  std::uint64_t below = total;  // of the keys at or above the last cut seen, starting below the first
+  for (std::size_t c = 0; c < cuts; ++c) {
+    const std::uint64_t cut = cut_keys[c];
+    std::uint64_t above = 0;
+    for (std::size_t i = 0; i < n; ++i) above += keys[i] >= cut ? weight(i) : 0;
+    per_rank[c] += below - above;
+    below = above;
+  }
+  per_rank[cuts] += below;
+}
+
 // What one call moved: particles sent to other ranks (this rank's count).
 struct Distribution {
   std::uint64_t first_global_index = 0;  // of this rank's first particle, in the new order
@@ -99,11 +145,9 @@ Distribution distribute_in_key_order(const Communicator& comm, ParticleSet<Real>
   std::vector<std::size_t> per_rank(ranks, 0);
   const std::uint64_t above_bits = key_bits == 64 ? 0 : ~((std::uint64_t{1} << key_bits) - 1);
   std::uint64_t stray_bits = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    destination[i] = owner_of(keys[i], cut_keys);
-    ++per_rank[static_cast<std::size_t>(destination[i])];
-    stray_bits |= keys[i] & above_bits;
-  }
+  owners_of(keys, cut_keys, destination);
+  sum_per_rank(keys, cut_keys, [](std::size_t) { return std::uint64_t{1}; }, per_rank);
+  for (std::size_t i = 0; i < n; ++i) stray_bits |= keys[i] & above_bits;
   if (stray_bits != 0) throw std::invalid_argument("distribute_in_key_order: a key has bits above key_bits");
   const std::size_t staying = per_rank[static_cast<std::size_t>(me)];
   std::vector<Bytes> send(ranks);

@@ -175,7 +175,7 @@ class RankOrder {
     const bool skin = request_.keep_within > 0;
     if (skin && valid_ && keys_.size() == p.size() && within_tolerance(p)) return false;
     bool fits = false;
-    frame_ = global_key_frame(*comm_, p, request_, fits);
+    frame_ = global_key_frame(*comm_, p, request_, fits, block_size);
     cells_fit_ = fits;
     keys_in_frame(frame_, p, keys_);
     costs_.assign(keys_.size(), 1);

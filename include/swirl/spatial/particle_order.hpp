@@ -221,11 +221,28 @@ class ParticleOrder {
 
   static Bounds bounds_of(const ParticleSet<Real>& p, std::size_t block_size, const Real* x, const Real* y,
                           const Real* z) {
+    const LocalBounds box = local_bounds(p.size(), block_size, x, y, z);
+    if (!box.finite) throw NonFinitePosition();
+    return {box.lo, box.hi};
+  }
+
+  KeyFrame make_frame(const Bounds& b) { return frame_for(request_, b.lo, b.hi, cells_fit_); }
+
+ public:
+  // The bounding box of n positions (exact min and max per axis, in double;
+  // zero for none) and whether every coordinate is finite: one vectorised pass
+  // over fixed blocks, the same for any thread count. update()'s bounds, and
+  // each rank's share of the global box (dist::global_key_frame).
+  struct LocalBounds {
+    std::array<double, 3> lo, hi;
+    bool finite;
+  };
+  static LocalBounds local_bounds(std::size_t n, std::size_t block_size, const Real* x, const Real* y, const Real* z) {
     using MinMax = std::array<double, 7>;  // lo xyz, hi xyz, and Σ x·0 (NaN iff some x is not finite)
     constexpr double inf = std::numeric_limits<double>::infinity();
     const MinMax init{inf, inf, inf, -inf, -inf, -inf, 0};
     const MinMax box = parallel::reduce_blocks_pinned(
-        "order_bounds", p.size(), block_size, init,
+        "order_bounds", n, block_size, init,
         [&](std::size_t b, std::size_t e) {
           MinMax m = init;
           const Real* axes[3] = {x, y, z};
@@ -252,20 +269,16 @@ class ParticleOrder {
           a[6] += b[6];
           return a;
         });
-    if (box[6] != 0) throw NonFinitePosition();
-    Bounds out{};
+    LocalBounds out{};
+    out.finite = box[6] == 0;
     for (std::size_t a = 0; a < 3; ++a) {
-      out.lo[a] = p.empty() ? 0.0 : box[a];
-      out.hi[a] = p.empty() ? 0.0 : box[a + 3];
-      if (!std::isfinite(out.lo[a]) || !std::isfinite(out.hi[a]))
-        throw NonFinitePosition();
+      out.lo[a] = n == 0 ? 0.0 : box[a];
+      out.hi[a] = n == 0 ? 0.0 : box[a + 3];
+      out.finite = out.finite && std::isfinite(out.lo[a]) && std::isfinite(out.hi[a]);
     }
     return out;
   }
 
-  KeyFrame make_frame(const Bounds& b) { return frame_for(request_, b.lo, b.hi, cells_fit_); }
-
- public:
   // The key frame update() uses for particles whose bounding box is [lo, hi]
   // (per axis, in double) under `request`; cells_fit tells whether a cell
   // request could be honoured. A pure function: a distributed run computes the
