@@ -182,13 +182,13 @@ def peer_versions(python):
     return json.loads(r.stdout) if r.returncode == 0 else {"error": r.stderr.strip()}
 
 
-def run_swirl(swirl, n, threads, repeats, bh_openings, fmm_openings, seed):
+def run_swirl(swirl, n, threads, repeats, bh_openings, fmm_openings, seed, fmm_buckets=(64,)):
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for label, args in (
             ("BH", ["--methods", "barnes_hut", "--multipoles", "quadrupole", "--criteria", "barnes", "--bucket", "16",
                     "--opening", ",".join(map(str, bh_openings))]),
-            ("FMM", ["--methods", "fmm", "--fmm-orders", "3,5", "--fmm-buckets", "64",
+            ("FMM", ["--methods", "fmm", "--fmm-orders", "3,5", "--fmm-buckets", ",".join(map(str, fmm_buckets)),
                      "--opening", ",".join(map(str, fmm_openings))]),
         ):
             out = Path(tmp) / label
@@ -202,6 +202,8 @@ def run_swirl(swirl, n, threads, repeats, bh_openings, fmm_openings, seed):
                     config = f"{row['method']} θ={float(row['opening']):g}"
                     if row["method"] == "fmm":
                         config = f"fmm p={row['order']} θ={float(row['opening']):g}"
+                        if len(fmm_buckets) > 1:
+                            config += f" leaves {row['bucket']}"
                     rows.append({"code": "swirl", "config": config, "threads": threads,
                                  "ms": float(row["ms_per_evaluation"]), "error_median": float(row["error_median"])})
     return rows
@@ -230,6 +232,8 @@ def main():
     ap.add_argument("--pytreegrav-max", type=int, default=1 << 17, help="largest N pytreegrav runs at")
     ap.add_argument("--bh-opening", default="0.4,0.5,0.6,0.7,0.8")
     ap.add_argument("--fmm-opening", default="0.5,0.6,0.7,0.8")
+    ap.add_argument("--fmm-buckets", default="64",
+                    help="swirl's FMM leaf sizes (nbody.bucket_size; a list is a dimension of its configurations)")
     ap.add_argument("--out", default="bench/results/gravity-peers")
     ap.add_argument("--worker", choices=["fmm3d", "pytreegrav"], help=argparse.SUPPRESS)
     ap.add_argument("--worker-label", help=argparse.SUPPRESS)
@@ -263,7 +267,8 @@ def main():
             data = Path(tmp) / f"plummer-{n}.npz"
             np.savez(data, pos=pos, m=m, sample=sample, ref=ref)
             runners = [lambda: run_swirl(a.swirl, n, a.threads, a.repeats, [float(t) for t in a.bh_opening.split(",")],
-                                         [float(t) for t in a.fmm_opening.split(",")], a.seed)]
+                                         [float(t) for t in a.fmm_opening.split(",")], a.seed,
+                                         [int(b) for b in a.fmm_buckets.split(",")])]
             for py, label in fmm3d:
                 runners.append(lambda py=py, label=label: in_interpreter(py, "fmm3d", label, data, a.fmm3d_eps,
                                                                          a.repeats, a.threads))

@@ -3,7 +3,7 @@
 # scene (SPH, self-gravity by the tree, the direct sum or the FMM, both; block time
 # steps; DFSPH and boundary particles; probes,
 # obstacle forces and moving obstacles; inlets and outlets) on 1 (no mpirun), 2, 3 and 4 ranks
-# gives byte-identical frames (VTK, and HDF5 written through parallel HDF5), diagnostics, probes.csv and checkpoints; a run resumes on another rank count and ends with the one-rank
+# (x 1 and 2 threads) gives byte-identical frames (VTK, and HDF5 written through parallel HDF5), diagnostics, probes.csv and checkpoints; a run resumes on another rank count and ends with the one-rank
 # bytes; a blow-up stops every rank with the one-rank
 # message and keeps the frames; a scene part that is not distributed yet is
 # refused once with status 2 and leaves no folder; more ranks than particles
@@ -81,6 +81,13 @@ for n in 2 3 4; do
   [ "$(grep -c 'swirl run: done' "$out/stdout")" -eq 1 ] || fail "float on $n ranks: the summary is not printed exactly once"
 done
 
+# 1a. Two threads on each rank (OMP_NUM_THREADS is 1 in this test's
+#     environment): 2 ranks x 2 threads, the float run and the Plummer sphere
+#     of section 4, against the one-rank files.
+on_ranks 2 run "$scene" "${small[@]}" --steps 30 --checkpoint-every-steps 10 --threads 2 --out "$out/float_2x2"
+[ "$status" -eq 0 ] || { fail "float on 2 ranks x 2 threads: status $status"; cat "$out/stderr"; }
+same_files "$out/float_1" "$out/float_2x2" "float on 2 ranks x 2 threads"
+
 # 1b. The summary's communication figures (dist::Traffic, inside the steps)
 #     and the halo's ghosts per particle, as mean and max over 2 ranks.
 on_ranks 2 run "$scene" "${small[@]}" --steps 3 --out "$out/traffic" --summary-json "$out/traffic.json"
@@ -126,6 +133,9 @@ for n in 2 4; do
   [ "$status" -eq 0 ] || { fail "gravity on $n ranks: status $status"; cat "$out/stderr"; }
   same_files "$out/gravity_1" "$out/gravity_$n" "gravity on $n ranks"
 done
+on_ranks 3 run "${grav[@]}" --threads 2 --out "$out/gravity_3x2"
+[ "$status" -eq 0 ] || { fail "gravity on 3 ranks x 2 threads: status $status"; cat "$out/stderr"; }
+same_files "$out/gravity_1" "$out/gravity_3x2" "gravity on 3 ranks x 2 threads"
 drop=("$examples/self_gravitating_drop.toml" --set particles.0.count=1500 --until 0.1 --set output.interval=0.025)
 on_ranks 1 run "${drop[@]}" --out "$out/drop_1"
 [ "$status" -eq 0 ] || { fail "drop on 1 rank: status $status"; cat "$out/stderr"; }
