@@ -2,6 +2,7 @@
 
 import filecmp
 import os
+import shutil
 import signal
 import subprocess
 import threading
@@ -108,6 +109,31 @@ def test_resume_is_bit_identical(swirl, sph_scene, tmp_path):
     second = swirl.resume(part, steps=10)
     assert second["first_step"] == 10 and second["steps"] == 10
     assert filecmp.cmp(whole / "particles_000002.vtp", part / "particles_000002.vtp", shallow=False)
+
+
+def test_a_run_on_mpi_ranks_resumes_in_python(swirl, sph_scene, tmp_path):
+    # The module runs in one process; a run folder made by the CLI on 2 MPI ranks (its checkpoints are the
+    # one-rank bytes) resumes from Python to the frames of an uninterrupted Python run.
+    cli = cli_path()
+    mpiexec = shutil.which("mpiexec")
+    if cli is None or mpiexec is None:
+        pytest.skip("no swirl CLI or no mpiexec (make python-test sets SWIRL_CLI; make mpi installs OpenMPI)")
+    info = subprocess.run([cli, "info"], capture_output=True, text=True, check=True).stdout
+    if "MPI " not in info or "without MPI" in info:
+        pytest.skip("the swirl CLI was built without MPI")
+    whole = tmp_path / "whole"
+    swirl.run(sph_scene, whole, steps=20)
+    part = tmp_path / "part"
+    sets = [a for o in SPH_OVERRIDES for a in ("--set", o)]
+    env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
+    subprocess.run([mpiexec, "-n", "2", "--oversubscribe", cli, "run", str(EXAMPLES / "dam_break.toml"), *sets,
+                    "--steps", "10", "--checkpoint-every-steps", "5", "--out", str(part)],
+                   check=True, capture_output=True, env=env, timeout=300)
+    assert (part / "checkpoints" / "checkpoint_000000000010.swc").exists()
+    second = swirl.resume(part, steps=10)
+    assert second["first_step"] == 10 and second["steps"] == 10
+    for name in ("particles_000001.vtp", "particles_000002.vtp", "diagnostics.csv"):
+        assert filecmp.cmp(whole / name, part / name, shallow=False), name
 
 
 def test_ctrl_c_stops_the_run_with_a_checkpoint(swirl, sph_scene, tmp_path):
