@@ -339,7 +339,9 @@ void GravityForce<Real>::add_metrics(NamedValues& out) const {
 
 template <class Real>
 void GravityForce<Real>::add_rank_metrics(NamedValues& out) const {
-  // What the locally essential trees imported, per own particle (the export's volume).
+  // What the locally essential trees imported, per own particle (the export's volume);
+  // the replicated methods (direct sum, FMM) import the whole set and build no essential tree.
+  if (settings_.method != Method::BarnesHut) return;
   out.emplace_back("let_nodes_per_particle", own_particles_ > 0 ? imported_nodes_ / own_particles_ : 0.0);
   out.emplace_back("let_particles_per_particle", own_particles_ > 0 ? imported_particles_ / own_particles_ : 0.0);
 }
