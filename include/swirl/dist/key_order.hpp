@@ -77,15 +77,15 @@ void sum_per_rank(std::span<const std::uint64_t> keys, std::span<const std::uint
   }
   std::uint64_t total = 0;
   for (std::size_t i = 0; i < n; ++i) total += weight(i);
-  std::uint64_t below = total;  // of the keys at or above the last cut seen, starting below the first
+  std::uint64_t from_previous = total;  // Σ weight of the keys at or above the previous cut (all, before the first)
   for (std::size_t c = 0; c < cuts; ++c) {
     const std::uint64_t cut = cut_keys[c];
-    std::uint64_t above = 0;
-    for (std::size_t i = 0; i < n; ++i) above += keys[i] >= cut ? weight(i) : 0;
-    per_rank[c] += below - above;
-    below = above;
+    std::uint64_t from_this = 0;
+    for (std::size_t i = 0; i < n; ++i) from_this += keys[i] >= cut ? weight(i) : 0;
+    per_rank[c] += from_previous - from_this;  // the keys in [previous cut, this cut)
+    from_previous = from_this;
   }
-  per_rank[cuts] += below;
+  per_rank[cuts] += from_previous;
 }
 
 // What one call moved: particles sent to other ranks (this rank's count).
