@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -86,28 +87,30 @@ spatial::OrderRequest GravityForce<Real>::order_request() const {
 
 namespace {
 
-// The whole set's positions and masses on every rank, in rank order — the
-// one-rank memory order (dist/rank_order.hpp) — and, when keys is given, the
-// whole order's keys (each rank's keys() in rank order: the one-rank keys).
-// O(N) memory per rank. Collective.
+// The whole set's positions and masses into `all` (resized; its other
+// fields untouched), in rank order — the one-rank memory order
+// (dist/rank_order.hpp) — and, when keys is given, the whole order's keys
+// (each rank's keys() in rank order: the one-rank keys). O(N) memory per
+// rank, kept by the caller between evaluations. Collective.
 template <class Real>
-ParticleSet<Real> gather_whole(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p, const char* what,
-                               std::vector<std::uint64_t>* keys = nullptr) {
+void gather_whole(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p, const char* what,
+                  ParticleSet<Real>& all, std::vector<std::uint64_t>* keys = nullptr) {
   const dist::Communicator& comm = order.comm();
   const std::size_t n = p.size();
-  std::vector<Real> mine;
-  mine.reserve(4 * n);
-  for (const auto* a : {&p.position.x, &p.position.y, &p.position.z, &p.mass}) mine.insert(mine.end(), a->begin(), a->end());
-  ParticleSet<Real> all(order.global_count());
+  // This rank's message: its x, y, z and m arrays one after the other.
+  dist::Bytes mine(4 * n * sizeof(Real));
+  const AlignedVector<Real>* arrays[4] = {&p.position.x, &p.position.y, &p.position.z, &p.mass};
+  for (std::size_t a = 0; a < 4 && n > 0; ++a)
+    std::memcpy(mine.data() + a * n * sizeof(Real), arrays[a]->data(), n * sizeof(Real));
+  all.resize(order.global_count());
+  AlignedVector<Real>* into[4] = {&all.position.x, &all.position.y, &all.position.z, &all.mass};
   std::size_t at = 0;
-  for (const dist::Bytes& b : comm.all_gather(dist::to_bytes(std::span<const Real>(mine)))) {
-    std::vector<Real> theirs;
-    dist::append_values(b, theirs, what);
-    const std::size_t count = theirs.size() / 4;
-    if (theirs.size() % 4 != 0 || at + count > all.size())
+  for (const dist::Bytes& b : comm.all_gather(mine)) {
+    const std::size_t count = b.size() / (4 * sizeof(Real));
+    if (b.size() % (4 * sizeof(Real)) != 0 || at + count > all.size())
       throw std::runtime_error(std::string(what) + ": a rank sent a partial set");
-    for (int a = 0; a < 3; ++a) std::copy_n(theirs.data() + a * count, count, all.position[a].data() + at);
-    std::copy_n(theirs.data() + 3 * count, count, all.mass.data() + at);
+    for (std::size_t a = 0; a < 4 && count > 0; ++a)
+      std::memcpy(into[a]->data() + at, b.data() + a * count * sizeof(Real), count * sizeof(Real));
     at += count;
   }
   if (at != all.size()) throw std::runtime_error(std::string(what) + ": the ranks hold another particle count");
@@ -117,7 +120,6 @@ ParticleSet<Real> gather_whole(const dist::RankOrder<Real>& order, const Particl
     for (const dist::Bytes& b : comm.all_gather(dist::to_bytes(order.keys()))) dist::append_values(b, *keys, what);
     if (keys->size() != all.size()) throw std::runtime_error(std::string(what) + ": the ranks hold another key count");
   }
-  return all;
 }
 
 // This rank's own particles' entries of the whole set's field.
@@ -129,40 +131,29 @@ void keep_own(const GravityField<Real>& whole, std::size_t first, std::size_t n,
   std::copy_n(whole.potential.data() + first, n, own.potential.data());
 }
 
-// The direct sum on several ranks: every rank gathers the whole set
-// (gather_whole) and sums over all of it for its own active particles with
-// the one-rank direct_sum(), whose sum for a particle depends only on the
-// whole set's order: the one-rank bits. O(N) memory per rank, as the O(N²)
-// method's sizes allow. Fills own (one entry per own particle) and returns
-// the global count of active particles. Collective.
-template <class Real>
-std::uint64_t direct_sum_on_ranks(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p, Real softening,
-                                  std::size_t block_size, const ActiveSet& active, GravityField<Real>& own) {
-  const dist::Communicator& comm = order.comm();
-  const std::size_t n = p.size();
-  ParticleSet<Real> all = gather_whole(order, p, "direct sum on ranks");
-  // Only this rank's own active particles are summed.
-  std::vector<std::int32_t> flags(all.size(), 0);
-  const std::size_t first = order.first_global_index();
-  std::uint64_t active_count = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    flags[first + i] = active.contains(i) ? 1 : 0;
-    active_count += std::uint64_t(flags[first + i]);
-  }
-  GravityField<Real> field;
-  direct_sum(all, softening, block_size, field, ActiveSet{flags.data(), 1});
-  keep_own(field, first, n, own);
-  return comm.sum(active_count);
-}
-
 }  // namespace
 
 template <class Real>
 void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverContext<Real>& ctx) {
   if (ctx.ranks && settings_.method == Method::Direct) {
+    // Replicated: every rank gathers the whole set (gather_whole) and sums over
+    // all of it for its own active particles with the one-rank direct_sum(),
+    // whose sum for a particle depends only on the whole set's order: the
+    // one-rank bits (O(N) memory per rank, as the O(N²) method's sizes allow).
+    const dist::RankOrder<Real>& order = *ctx.ranks;
     const auto t0 = std::chrono::steady_clock::now();
+    gather_whole(order, p, "direct sum on ranks", whole_);
+    whole_active_.assign(whole_.size(), 0);  // only this rank's own active particles are summed
+    const std::size_t first = order.first_global_index();
+    std::uint64_t active_count = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      whole_active_[first + i] = ctx.active.contains(i) ? 1 : 0;
+      active_count += std::uint64_t(whole_active_[first + i]);
+    }
+    direct_sum(whole_, Real(settings_.softening), ctx.block_size, whole_field_, ActiveSet{whole_active_.data(), 1});
+    keep_own(whole_field_, first, p.size(), field_);
     stats_ = GravityStats{};
-    stats_.walked = direct_sum_on_ranks(*ctx.ranks, p, Real(settings_.softening), ctx.block_size, ctx.active, field_);
+    stats_.walked = order.comm().sum(active_count);
     stats_.mean_nodes_visited = double(ctx.ranks->global_count() - 1);
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   } else if (ctx.ranks && settings_.method != Method::Fmm) {
@@ -218,15 +209,13 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
       const dist::RankOrder<Real>& order = *ctx.ranks;
       const auto& f = order.frame();
       const bool sorted = views_order() && order.valid() && f.curve == spatial::CellOrder::Morton;
-      std::vector<std::uint64_t> keys;
-      const ParticleSet<Real> all = gather_whole(order, p, "the FMM on ranks", sorted ? &keys : nullptr);
-      GravityField<Real> whole;
+      gather_whole(order, p, "the FMM on ranks", whole_, sorted ? &whole_keys_ : nullptr);
       if (sorted)
-        fmm_.compute_sorted(all, keys, f.corner, f.root_side(), whole, ctx.block_size);
+        fmm_.compute_sorted(whole_, whole_keys_, f.corner, f.root_side(), whole_field_, ctx.block_size);
       else
-        fmm_.compute(all, whole, ctx.block_size);
-      keep_own(whole, order.first_global_index(), p.size(), field_);
-      whole_count = all.size();
+        fmm_.compute(whole_, whole_field_, ctx.block_size);
+      keep_own(whole_field_, order.first_global_index(), p.size(), field_);
+      whole_count = whole_.size();
     } else if (const auto* order = ctx.order; views_order() && order && order->valid() &&
                                               order->frame().curve == spatial::CellOrder::Morton &&
                                               order->keys().size() == p.size()) {
@@ -335,6 +324,14 @@ void GravityForce<Real>::add_metrics(NamedValues& out) const {
   out.emplace_back("particle_force_evaluations", particle_evaluations_);
   if (stats_.tree_bytes > 0 && particles_ > 0)
     out.emplace_back("tree_bytes_per_particle", double(stats_.tree_bytes) / double(particles_));
+}
+
+template <class Real>
+std::size_t GravityForce<Real>::scratch_bytes() const {
+  std::size_t whole = whole_.id.capacity() * sizeof(std::uint64_t) + whole_keys_.capacity() * sizeof(std::uint64_t) +
+                      whole_active_.capacity() * sizeof(std::int32_t) + 4 * whole_field_.potential.capacity() * sizeof(Real);
+  whole_.for_each_array([&](const AlignedVector<Real>& a) { whole += a.capacity() * sizeof(Real); });
+  return stats_.tree_bytes + whole;
 }
 
 template <class Real>

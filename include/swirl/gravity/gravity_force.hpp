@@ -92,7 +92,7 @@ class GravityForce final : public Solver<Real> {
   double potential_energy(const ParticleSet<Real>& particles, const dist::BlockFold& fold) const override;
   void add_metrics(NamedValues& out) const override;
   void add_rank_metrics(NamedValues& out) const override;
-  std::size_t scratch_bytes() const override { return stats_.tree_bytes; }
+  std::size_t scratch_bytes() const override;  // the tree, and on ranks the replicated methods' whole set
   void save_state(NamedValues& out) const override;
   void load_state(const NamedValues& values) override;
 
@@ -118,6 +118,14 @@ class GravityForce final : public Solver<Real> {
   // particles, and this rank's own particles.
   double imported_nodes_ = 0, imported_particles_ = 0, own_particles_ = 0;
   Fmm<Real> fmm_;
+  // On ranks, the replicated methods (direct sum, FMM): the whole set gathered
+  // here (positions and masses), its keys, which of its particles are this
+  // rank's active ones, and its field; kept between evaluations so that a
+  // step does not allocate them again.
+  ParticleSet<Real> whole_;
+  std::vector<std::uint64_t> whole_keys_;
+  std::vector<std::int32_t> whole_active_;
+  GravityField<Real> whole_field_;
   GravityField<Real> field_;
   GravityStats stats_;
   double nodes_sum_ = 0;  // Σ mean_nodes_visited over evaluations (the summary's mean)
