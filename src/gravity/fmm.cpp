@@ -389,17 +389,41 @@ LinearTreeSettings Fmm<Real>::tree_settings() const {
 }
 
 template <class Real>
-void Fmm<Real>::compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size) {
+void Fmm<Real>::compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+                        const ActiveSet& active) {
   const auto t0 = std::chrono::steady_clock::now();
   tree_.build(p, tree_settings(), block_size);
-  evaluate_order(out, block_size, seconds_since(t0));
+  evaluate_order(out, block_size, seconds_since(t0), active);
+}
+
+// active_cell_ from the particles' flags: a node's particles are the sorted
+// slots [begin, end), so one prefix count over the slots answers every node.
+template <class Real>
+void Fmm<Real>::mark_active_cells(const ActiveSet& active) {
+  const std::size_t n = tree_.x().size();
+  if (active.all()) {
+    active_cell_.clear();
+    stats_.active = n;
+    return;
+  }
+  const auto order = tree_.order();
+  std::vector<std::uint64_t>& before = active_before_;  // active slots before slot s
+  before.resize(n + 1);
+  before[0] = 0;
+  for (std::size_t s = 0; s < n; ++s) before[s + 1] = before[s] + (active.contains(order[s]) ? 1u : 0u);
+  stats_.active = before[n];
+  const LinearNodes<Real>& t = tree_.nodes();
+  active_cell_.resize(t.size());
+  for (std::size_t c = 0; c < t.size(); ++c) active_cell_[c] = before[t.end[c]] > before[t.begin[c]] ? 1 : 0;
 }
 
 // The expansion order is a template parameter (the M2L tables unroll at compile time).
 template <class Real>
-void Fmm<Real>::evaluate_order(GravityField<Real>& out, std::size_t block_size, double tree_seconds) {
+void Fmm<Real>::evaluate_order(GravityField<Real>& out, std::size_t block_size, double tree_seconds,
+                               const ActiveSet& active) {
   stats_ = FmmStats{};
   stats_.tree_seconds = tree_seconds;
+  mark_active_cells(active);
   switch (settings_.order) {
     case 2: evaluate<2>(out, block_size); break;
     case 3: evaluate<3>(out, block_size); break;
@@ -411,10 +435,10 @@ void Fmm<Real>::evaluate_order(GravityField<Real>& out, std::size_t block_size, 
 template <class Real>
 void Fmm<Real>::compute_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
                                const std::array<double, 3>& corner, double side, GravityField<Real>& out,
-                               std::size_t block_size) {
+                               std::size_t block_size, const ActiveSet& active) {
   const auto t0 = std::chrono::steady_clock::now();
   tree_.build_sorted(p, sorted_keys, corner, side, tree_settings(), block_size);
-  evaluate_order(out, block_size, seconds_since(t0));
+  evaluate_order(out, block_size, seconds_since(t0), active);
 }
 
 template <class Real>
@@ -454,7 +478,8 @@ void Fmm<Real>::evaluate(GravityField<Real>& out, std::size_t block_size) {
   stats_.bytes = tree_.bytes() +
                  sizeof(double) * (zx_.size() * 5 + multipoles_.size() + locals_.size() + 4 * ax_.size() +
                                    buffer_.capacity()) +
-                 sizeof(Pair) * (m2l_.capacity() + p2p_.capacity());
+                 sizeof(Pair) * (m2l_.capacity() + p2p_.capacity()) + active_cell_.capacity() +
+                 sizeof(std::uint64_t) * active_before_.capacity();
 }
 
 // Centres of mass, radii and multipoles, deepest level first; each node is
@@ -659,6 +684,17 @@ void Fmm<Real>::walk(std::uint64_t direct_pairs) {
   std::uint64_t pairs = 0;
   for (const Pair& q : p2p_) pairs += q.a == q.b ? size(q.a) * (size(q.a) - 1) / 2 : size(q.a) * size(q.b);
   stats_.p2p_pairs = pairs;
+  // With an active set, only the interactions with an active cell on a side
+  // are computed (fmm.hpp): a stable filter keeps their order. The walk
+  // itself and the figures above stay the full evaluation's (the same for
+  // any active set, and on MPI ranks the one-rank figures).
+  if (!active_cell_.empty()) {
+    const auto inactive = [&](const Pair& q) { return !cell_active(q.a) && !cell_active(q.b); };
+    std::erase_if(m2l_, inactive);
+    std::erase_if(p2p_, inactive);
+  }
+  stats_.m2l_computed = m2l_.size();
+  stats_.p2p_cells_computed = p2p_.size();
 }
 
 // The mutual M2L in chunks: D(z_A − z_B) once per pair, both sides' local
@@ -693,11 +729,11 @@ void Fmm<Real>::interact_m2l() {
         for (std::size_t q = 0; q < count; ++q) {
           const Pair pr = m2l_[start + q];
           const double* ca = &buffer_[q * 2 * O::KL];
-          if (pr.a >= lo && pr.a < hi) {
+          if (pr.a >= lo && pr.a < hi && cell_active(pr.a)) {
             double* C = &locals_[std::size_t(pr.a) * O::KL];
             for (std::size_t k = 0; k < O::KL; ++k) C[k] += ca[k];
           }
-          if (pr.b >= lo && pr.b < hi) {
+          if (pr.b >= lo && pr.b < hi && cell_active(pr.b)) {
             double* C = &locals_[std::size_t(pr.b) * O::KL];
             for (std::size_t k = 0; k < O::KL; ++k) C[k] += ca[O::KL + k];
           }
@@ -787,32 +823,51 @@ void Fmm<Real>::interact_p2p() {
           continue;
         }
         // Mutual: a_i += m_j d/R³ and a_j −= m_i d/R³ from one term (d = x_j − x_i).
-        for (std::uint32_t i = a0; i < a1; ++i) {
-          const double xi = double(x[i]), yi = double(y[i]), zi = double(z[i]), mi = double(m[i]);
-          double vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, vp[kLanes] = {};
-          for (std::size_t j0 = 0; j0 < nb; j0 += kLanes) {
+        // With an active set, a side whose cell holds no active particle is
+        // not summed (its sums would be dropped): the other side's
+        // expressions and order are the mutual loop's, so its bits are too.
+        const auto sides = [&]<bool kSideA, bool kSideB>() {
+          for (std::uint32_t i = a0; i < a1; ++i) {
+            const double xi = double(x[i]), yi = double(y[i]), zi = double(z[i]), mi = double(m[i]);
+            double vx[kLanes] = {}, vy[kLanes] = {}, vz[kLanes] = {}, vp[kLanes] = {};
+            for (std::size_t j0 = 0; j0 < nb; j0 += kLanes) {
 #pragma omp simd
-            for (std::size_t l = 0; l < kLanes; ++l) {
-              const std::size_t j = j0 + l;
-              const double dx = bx[j] - xi, dy = by[j] - yi, dz = bz[j] - zi;
-              const double inv = inverse_distance(dx * dx + dy * dy + dz * dz + eps2);
-              const double inv3 = inv * inv * inv, fi = bm[j] * inv3, fj = mi * inv3;
-              vx[l] += fi * dx;
-              vy[l] += fi * dy;
-              vz[l] += fi * dz;
-              vp[l] += bm[j] * inv;
-              gx[j] -= fj * dx;
-              gy[j] -= fj * dy;
-              gz[j] -= fj * dz;
-              gp[j] -= mi * inv;
+              for (std::size_t l = 0; l < kLanes; ++l) {
+                const std::size_t j = j0 + l;
+                const double dx = bx[j] - xi, dy = by[j] - yi, dz = bz[j] - zi;
+                const double inv = inverse_distance(dx * dx + dy * dy + dz * dz + eps2);
+                const double inv3 = inv * inv * inv, fi = bm[j] * inv3, fj = mi * inv3;
+                if constexpr (kSideA) {
+                  vx[l] += fi * dx;
+                  vy[l] += fi * dy;
+                  vz[l] += fi * dz;
+                  vp[l] += bm[j] * inv;
+                }
+                if constexpr (kSideB) {
+                  gx[j] -= fj * dx;
+                  gy[j] -= fj * dy;
+                  gz[j] -= fj * dz;
+                  gp[j] -= mi * inv;
+                }
+              }
+            }
+            if constexpr (kSideA) {
+              const std::size_t k = i - a0;
+              ax[k] = lane_sum(vx);
+              ay[k] = lane_sum(vy);
+              az[k] = lane_sum(vz);
+              ap[k] = -lane_sum(vp);
             }
           }
-          const std::size_t k = i - a0;
-          ax[k] = lane_sum(vx);
-          ay[k] = lane_sum(vy);
-          az[k] = lane_sum(vz);
-          ap[k] = -lane_sum(vp);
-        }
+        };
+        const bool side_a = cell_active(pr.a), side_b = cell_active(pr.b);
+        if (side_a && side_b)
+          sides.template operator()<true, true>();
+        else if (side_a)
+          sides.template operator()<true, false>();
+        else
+          sides.template operator()<false, true>();
+        if (!side_b) continue;
         const std::size_t nbr = t.end[pr.b] - t.begin[pr.b];
         double* sb = ap + na;
         std::copy(gx, gx + nbr, sb);
@@ -839,8 +894,8 @@ void Fmm<Real>::interact_p2p() {
         for (std::size_t q = 0; q < stop - start; ++q) {
           const Pair pr = p2p_[start + q];
           const double* from = &buffer_[offsets_[q]];
-          add(pr.a, from);
-          if (pr.a != pr.b) add(pr.b, from + 4 * std::size_t(t.end[pr.a] - t.begin[pr.a]));
+          if (cell_active(pr.a)) add(pr.a, from);
+          if (pr.a != pr.b && cell_active(pr.b)) add(pr.b, from + 4 * std::size_t(t.end[pr.a] - t.begin[pr.a]));
         }
       }
     });
@@ -878,7 +933,7 @@ void Fmm<Real>::downward(GravityField<Real>& out, std::size_t block_size) {
   node_blocks("fmm_l2p", count, [&](std::size_t b, std::size_t e, std::size_t) {
     double T[O::KL];
     for (std::size_t node = b; node < e; ++node) {
-      if (t.child_count[node] != 0) continue;
+      if (t.child_count[node] != 0 || !cell_active(std::uint32_t(node))) continue;
       const double* C = &locals_[node * O::KL];
       for (std::uint32_t s = t.begin[node]; s < t.end[node]; ++s) {
         powers<O::Q>(double(x[s]) - zx_[node], double(y[s]) - zy_[node], double(z[s]) - zz_[node], T);

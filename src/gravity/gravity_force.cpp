@@ -122,6 +122,20 @@ void gather_whole(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p
   }
 }
 
+// Flags, over the whole set, this rank's own active particles (the others
+// 0): the replicated methods then compute only what this rank keeps. Returns
+// their number.
+std::uint64_t flag_own_active(std::size_t first, std::size_t n, const ActiveSet& active,
+                                     std::vector<std::int32_t>& whole_active, std::size_t whole_count) {
+  whole_active.assign(whole_count, 0);
+  std::uint64_t count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    whole_active[first + i] = active.contains(i) ? 1 : 0;
+    count += std::uint64_t(whole_active[first + i]);
+  }
+  return count;
+}
+
 // This rank's own particles' entries of the whole set's field.
 template <class Real>
 void keep_own(const GravityField<Real>& whole, std::size_t first, std::size_t n, GravityField<Real>& own) {
@@ -143,13 +157,8 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     const dist::RankOrder<Real>& order = *ctx.ranks;
     const auto t0 = std::chrono::steady_clock::now();
     gather_whole(order, p, "direct sum on ranks", whole_);
-    whole_active_.assign(whole_.size(), 0);  // only this rank's own active particles are summed
     const std::size_t first = order.first_global_index();
-    std::uint64_t active_count = 0;
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      whole_active_[first + i] = ctx.active.contains(i) ? 1 : 0;
-      active_count += std::uint64_t(whole_active_[first + i]);
-    }
+    const std::uint64_t active_count = flag_own_active(first, p.size(), ctx.active, whole_active_, whole_.size());
     direct_sum(whole_, Real(settings_.softening), ctx.block_size, whole_field_, ActiveSet{whole_active_.data(), 1});
     keep_own(whole_field_, first, p.size(), field_);
     stats_ = GravityStats{};
@@ -199,30 +208,40 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     for (std::size_t i = 0; i < p.size(); ++i) stats_.walked += ctx.active.contains(i);
     stats_.force_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   } else if (settings_.method == Method::Fmm) {
-    // Every particle, whatever the active set (fmm.hpp); the loop below writes the active ones.
+    // The active particles' field (fmm.hpp: the interactions of active cells
+    // only, each active particle's field the full evaluation's bits); the
+    // loop below writes the active ones.
     std::size_t whole_count = p.size();
+    std::uint64_t computed = 0;
     if (ctx.ranks) {
       // Several ranks, replicated: every rank gathers the whole set (and the
       // order's keys) in the one-rank memory order and runs the one-rank FMM
-      // over all of it, keeping its own particles' field: the one-rank bits;
-      // no gain from the ranks (each computes the whole; its threads share it).
+      // over all of it with its own active particles as the active set,
+      // keeping their field: the one-rank bits. The tree and the upward pass
+      // are every rank's; the interactions divide among the ranks.
       const dist::RankOrder<Real>& order = *ctx.ranks;
       const auto& f = order.frame();
       const bool sorted = views_order() && order.valid() && f.curve == spatial::CellOrder::Morton;
       gather_whole(order, p, "the FMM on ranks", whole_, sorted ? &whole_keys_ : nullptr);
+      const std::uint64_t own =
+          flag_own_active(order.first_global_index(), p.size(), ctx.active, whole_active_, whole_.size());
+      const ActiveSet own_active{whole_active_.data(), 1};
       if (sorted)
-        fmm_.compute_sorted(whole_, whole_keys_, f.corner, f.root_side(), whole_field_, ctx.block_size);
+        fmm_.compute_sorted(whole_, whole_keys_, f.corner, f.root_side(), whole_field_, ctx.block_size, own_active);
       else
-        fmm_.compute(whole_, whole_field_, ctx.block_size);
+        fmm_.compute(whole_, whole_field_, ctx.block_size, own_active);
       keep_own(whole_field_, order.first_global_index(), p.size(), field_);
       whole_count = whole_.size();
+      computed = order.comm().sum(own);
     } else if (const auto* order = ctx.order; views_order() && order && order->valid() &&
                                               order->frame().curve == spatial::CellOrder::Morton &&
                                               order->keys().size() == p.size()) {
       const auto& f = order->frame();
-      fmm_.compute_sorted(p, order->keys(), f.corner, f.root_side(), field_, ctx.block_size);
+      fmm_.compute_sorted(p, order->keys(), f.corner, f.root_side(), field_, ctx.block_size, ctx.active);
+      computed = fmm_.stats().active;
     } else {
-      fmm_.compute(p, field_, ctx.block_size);
+      fmm_.compute(p, field_, ctx.block_size, ctx.active);
+      computed = fmm_.stats().active;
     }
     const FmmStats& fs = fmm_.stats();
     stats_ = GravityStats{};
@@ -231,7 +250,7 @@ void GravityForce<Real>::add_acceleration(ParticleSet<Real>& p, const SolverCont
     // and the terms evaluated (two per mutual interaction: one for each side).
     stats_.mean_nodes_visited = 2.0 * double(fs.m2l + fs.p2p_cells) / n;
     stats_.mean_interactions = 2.0 * double(fs.m2l + fs.p2p_pairs) / n;
-    stats_.walked = whole_count;
+    stats_.walked = computed;
     stats_.trees = 1;
     stats_.nodes = fs.nodes;
     stats_.depth = fs.depth;

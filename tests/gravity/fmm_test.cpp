@@ -1,12 +1,15 @@
 // The fast multipole method (fmm.hpp) against the direct sum: the error falls
 // with the expansion order as θ^{p+1} says, θ = 0 is the direct sum, the
 // mutual interactions conserve momentum to round-off, the result is the same
-// bits for any thread count, and it runs as the scene's nbody.method.
+// bits for any thread count, an active set's particles get the full
+// evaluation's bits, and it runs as the scene's nbody.method.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -194,6 +197,58 @@ TYPED_TEST(FmmTest, OneTwoAndThreeThreadsGiveTheSameBits) {
     for (int threads : {2, 3}) {
       parallel::set_thread_count(threads);
       EXPECT_TRUE(testing::same_bits(one, fmm_field(p, 4, 0.5, 0.01, bucket))) << threads << " threads";
+    }
+  }
+  parallel::set_thread_count(saved);
+}
+
+// Block time steps: with an active set only the interactions of cells that
+// hold an active particle are computed, and every active particle's field is
+// the full evaluation's, bit for bit (fmm.hpp), for any thread count; a set
+// with no active particle computes nothing.
+TYPED_TEST(FmmTest, ActiveParticlesGetTheFullEvaluationsBits) {
+  using Real = TypeParam;
+  const int saved = parallel::thread_count();
+  const ParticleSet<Real> p = plummer<Real>(12000, 7);
+  std::vector<std::int32_t> bins(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) bins[i] = std::int32_t((i * 2654435761u >> 7) % 97 == 0 ? 3 : i % 3);
+  for (int order : {2, 5}) {
+    parallel::set_thread_count(1);
+    FmmStats full_stats;
+    const GravityField<Real> full = fmm_field(p, order, 0.6, 0.01, 16, &full_stats);
+    EXPECT_EQ(full_stats.m2l_computed, full_stats.m2l);
+    EXPECT_EQ(full_stats.p2p_cells_computed, full_stats.p2p_cells);
+    for (std::int32_t min_bin : {1, 3, 4}) {
+      SCOPED_TRACE(::testing::Message() << "p " << order << ", active: bin >= " << min_bin);
+      const ActiveSet active{bins.data(), min_bin};
+      std::size_t expected = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) expected += active.contains(i);
+      GravityField<Real> first;
+      for (int threads : {1, 2, 3}) {
+        parallel::set_thread_count(threads);
+        Fmm<Real> fmm(FmmSettings{order, 0.6, 0.01, 16});
+        GravityField<Real> f;
+        fmm.compute(p, f, 256, active);
+        const FmmStats& st = fmm.stats();
+        EXPECT_EQ(st.active, expected);
+        EXPECT_EQ(st.m2l, full_stats.m2l) << "the walk's figures are the full evaluation's";
+        if (min_bin == 4) {
+          EXPECT_EQ(st.m2l_computed + st.p2p_cells_computed, 0u) << "nothing active, nothing computed";
+          continue;
+        }
+        if (min_bin == 3) {  // 1 % of the particles, scattered: most cells hold none
+          EXPECT_LT(st.m2l_computed, full_stats.m2l / 2) << "inactive cells' interactions skipped";
+          EXPECT_LT(st.p2p_cells_computed, full_stats.p2p_cells / 2);
+        }
+        const auto differs = [](Real x, Real y) { return std::memcmp(&x, &y, sizeof(Real)) != 0; };
+        std::size_t differing = 0;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+          if (!active.contains(i)) continue;
+          for (int a = 0; a < 3; ++a) differing += differs(f.acceleration[a][i], full.acceleration[a][i]);
+          differing += differs(f.potential[i], full.potential[i]);
+        }
+        EXPECT_EQ(differing, 0u) << threads << " threads";
+      }
     }
   }
   parallel::set_thread_count(saved);

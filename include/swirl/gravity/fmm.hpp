@@ -62,9 +62,17 @@
 // order. Upward and downward passes are level by level, each node written by
 // one block. So the result is bit-identical for any thread count.
 //
-// Active sets (block time steps): Fmm computes every particle (the mutual
-// interactions do not separate by target); GravityForce writes only the
-// active ones.
+// Active sets (block time steps; on MPI ranks, a rank's own particles): a
+// cell is active when it holds an active particle. The walk runs in full (its
+// figures in FmmStats are the full evaluation's); then only the interactions
+// with an active cell on at least one side are kept, in their order, for the
+// M2L and the P2P; only active cells receive their terms (a P2P sums only its
+// active sides, by the mutual loop's expressions in its order), and only
+// active leaves are evaluated (L2P). Every active cell so receives the same
+// terms in the same order as in a full evaluation, and every active
+// particle's field is the full evaluation's, bit for bit.
+// The upward pass covers every particle (the sources are all of them); what
+// an evaluation leaves for inactive particles is unspecified.
 //
 // Units: G = 1; lengths as the positions.
 #pragma once
@@ -75,6 +83,7 @@
 #include <span>
 #include <vector>
 
+#include "swirl/core/active_set.hpp"
 #include "swirl/core/particle_set.hpp"
 #include "swirl/gravity/field.hpp"
 #include "swirl/gravity/linear_octree.hpp"
@@ -97,6 +106,8 @@ struct FmmStats {
   std::uint64_t p2p_cells = 0;    // P2P cell pairs and cell self-interactions
   std::uint64_t p2p_pairs = 0;    // particle pairs interacting directly (each counts once)
   std::size_t tasks = 0;          // walk tasks
+  std::size_t active = 0;         // particles computed (all, or the active set's)
+  std::uint64_t m2l_computed = 0, p2p_cells_computed = 0;  // the interactions kept for them
   std::size_t nodes = 0, leaves = 0;
   int depth = 0;
   double tree_seconds = 0;        // keys, sort, nodes (LinearOctree)
@@ -114,14 +125,16 @@ class Fmm {
   // Validates the settings (std::invalid_argument).
   explicit Fmm(const FmmSettings& settings = {});
 
-  // Overwrites out (resized to p.size()) with the field of p: every particle.
+  // Overwrites out (resized to p.size()) with the field of p: every particle,
+  // or the active ones (by index in p; the others' entries are unspecified).
   // block_size: the per-particle passes' block (results do not depend on it).
-  void compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size);
+  void compute(const ParticleSet<Real>& p, GravityField<Real>& out, std::size_t block_size,
+               const ActiveSet& active = {});
   // The same on particles already sorted by 63-bit Morton keys (the
   // simulation's order, as LinearOctree::build_sorted): no sort, no copy.
   void compute_sorted(const ParticleSet<Real>& p, std::span<const std::uint64_t> sorted_keys,
                       const std::array<double, 3>& corner, double side, GravityField<Real>& out,
-                      std::size_t block_size);
+                      std::size_t block_size, const ActiveSet& active = {});
 
   const FmmSettings& settings() const { return settings_; }
   const FmmStats& stats() const { return stats_; }
@@ -135,7 +148,8 @@ class Fmm {
     std::vector<Pair> m2l, p2p;
     std::vector<Pair> stack;
   };
-  void evaluate_order(GravityField<Real>& out, std::size_t block_size, double tree_seconds);
+  void evaluate_order(GravityField<Real>& out, std::size_t block_size, double tree_seconds, const ActiveSet& active);
+  void mark_active_cells(const ActiveSet& active);
   template <int P>
   void evaluate(GravityField<Real>& out, std::size_t block_size);
   template <int P>
@@ -156,6 +170,12 @@ class Fmm {
   std::vector<double> zx_, zy_, zz_, mass_, radius_;
   std::vector<double> multipoles_, locals_;
   std::vector<std::size_t> level_start_;  // nodes of level l: [level_start_[l], level_start_[l + 1])
+  // Per node: holds an active particle (empty: every node is active); and the
+  // count of active sorted slots before each slot, which finds them.
+  std::vector<std::uint8_t> active_cell_;
+  std::vector<std::uint64_t> active_before_;
+  // Whether cell c's terms are wanted: no active set, or c holds an active particle.
+  bool cell_active(std::uint32_t c) const { return active_cell_.empty() || active_cell_[c] != 0; }
   // Per sorted slot: the field, summed in double.
   std::vector<double> ax_, ay_, az_, phi_;
   std::vector<Pair> m2l_, p2p_;

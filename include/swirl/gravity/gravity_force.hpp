@@ -24,8 +24,9 @@
 //
 // With an active set in the context (block time steps) only the active
 // particles' acceleration and potential are computed and written (the linear
-// tree and the direct sum skip the others; the paper's schemes and the FMM
-// compute all: the FMM's mutual interactions do not separate by target).
+// tree, the direct sum and the FMM skip the others — the FMM keeps the
+// interactions of cells holding an active particle; the paper's schemes
+// compute all).
 // The metric particle_force_evaluations counts the particles computed over
 // the run: the cost measure block steps are judged by.
 //
@@ -35,10 +36,11 @@
 // order, whose cuts rank_cuts() puts on group boundaries: every particle's
 // field is the one-rank field, bit for bit. The direct sum and the FMM run
 // there replicated: every rank gathers the whole set (positions, masses, the
-// order's keys) in the one-rank memory order, computes the one-rank field of
-// all of it and keeps its own particles' (the one-rank bits; O(N) memory per
-// rank, no gain from the ranks). The paper's schemes and the particle walk
-// are refused there.
+// order's keys) in the one-rank memory order and computes the one-rank field
+// of its own particles only, as an active set (the one-rank bits; O(N)
+// memory per rank; the FMM's tree and upward pass are every rank's, its
+// interactions divide among the ranks). The paper's schemes and the particle
+// walk are refused there.
 #pragma once
 
 #include <string>
