@@ -126,7 +126,7 @@ void gather_whole(const dist::RankOrder<Real>& order, const ParticleSet<Real>& p
 // 0): the replicated methods then compute only what this rank keeps. Returns
 // their number.
 std::uint64_t flag_own_active(std::size_t first, std::size_t n, const ActiveSet& active,
-                                     std::vector<std::int32_t>& whole_active, std::size_t whole_count) {
+                              std::vector<std::int32_t>& whole_active, std::size_t whole_count) {
   whole_active.assign(whole_count, 0);
   std::uint64_t count = 0;
   for (std::size_t i = 0; i < n; ++i) {

@@ -223,7 +223,6 @@ TYPED_TEST(FmmTest, ActiveParticlesGetTheFullEvaluationsBits) {
       const ActiveSet active{bins.data(), min_bin};
       std::size_t expected = 0;
       for (std::size_t i = 0; i < p.size(); ++i) expected += active.contains(i);
-      GravityField<Real> first;
       for (int threads : {1, 2, 3}) {
         parallel::set_thread_count(threads);
         Fmm<Real> fmm(FmmSettings{order, 0.6, 0.01, 16});
