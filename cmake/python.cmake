@@ -20,7 +20,7 @@ find_package(nanobind CONFIG REQUIRED PATHS "${SWIRL_NANOBIND_DIR}" NO_DEFAULT_P
 # this build tree only (the CLI's trees are unchanged). -fno-semantic-interposition
 # keeps GCC inlining and calling swirl's own functions directly as it does
 # without -fPIC (nothing interposes them: the module hides every symbol).
-foreach(lib swirl_dist swirl_io swirl_gravity swirl_scene swirl_sph swirl_sim swirl_render swirl_view swirl_cli_commands)
+foreach(lib swirl_core swirl_spatial swirl_force swirl_integrate swirl_dist swirl_io swirl_gravity swirl_scene swirl_sph swirl_sim swirl_render swirl_view swirl_cli_commands)
   set_target_properties(${lib} PROPERTIES POSITION_INDEPENDENT_CODE ON)
   target_compile_options(${lib} PRIVATE -fno-semantic-interposition)
 endforeach()

@@ -121,10 +121,10 @@ for pair in "2 3" "4 1"; do
   done
 done
 
-# 4. Self-gravity (the locally essential tree): a Plummer sphere of 2 000
+# 4. Self-gravity (the locally essential tree): a Plummer sphere of 1 000
 #    stars, 12 steps, on 2 and 4 ranks against one; then SPH with self-gravity,
 #    drag and adaptive steps (a self-gravitating drop of 1 500 particles) on 3.
-grav=("$examples/plummer.toml" --set particles.0.count=2000 --set output.interval=0.0625 --steps 12
+grav=("$examples/plummer.toml" --set particles.0.count=1000 --set output.interval=0.0625 --steps 12
       --checkpoint-every-steps 6)
 on_ranks 1 run "${grav[@]}" --out "$out/gravity_1"
 [ "$status" -eq 0 ] || { fail "gravity on 1 rank: status $status"; cat "$out/stderr"; }
@@ -144,13 +144,13 @@ on_ranks 3 run "${drop[@]}" --out "$out/drop_3"
 same_files "$out/drop_1" "$out/drop_3" "SPH with self-gravity on 3 ranks"
 
 # 4a. Block time steps (integrate/block_steps.hpp) on ranks: a Hernquist halo
-#     of 1 000 stars (its cusp spreads the bins over several levels), dt =
+#     of 400 stars (its cusp spreads the bins over six levels, 0-5), dt =
 #     1/16, against one rank as against_one does (2 and 3 ranks, resumed 3 -> 2).
 #     Every sub-step's sort, active groups' essential tree and finest bin are
 #     collective. Frames in HDF5 only: every rank writes its own particles
 #     (nothing is gathered for them).
 against_one block "block steps" "particles_000015.h5 particles.xdmf diagnostics.csv checkpoints/checkpoint_000000000030.swc" \
-  "$examples/hernquist.toml" --set particles.0.count=1000 --set 'simulation.time_steps="block"' --set 'output.format="hdf5"' \
+  "$examples/hernquist.toml" --set particles.0.count=400 --set 'simulation.time_steps="block"' --set 'output.format="hdf5"' \
   --set simulation.dt=0.0625 --set simulation.max_bin=12 --set simulation.eta=0.2 --set output.interval=0.125
 
 # 4a'. The direct sum on ranks (every rank gathers the whole set's positions
@@ -170,10 +170,10 @@ for variant in global block; do
 done
 
 # 4a''. The FMM on ranks (replicated: every rank gathers the whole set and
-#       runs the one-rank FMM): a Plummer sphere of 2 000 stars, p = 4, with
+#       runs the one-rank FMM): a Plummer sphere of 800 stars, p = 4, with
 #       block time steps, against one rank as against_one does.
 against_one fmm "the FMM with block steps" "particles_000015.h5 diagnostics.csv checkpoints/checkpoint_000000000030.swc" \
-  "$examples/plummer.toml" --set particles.0.count=2000 --set 'nbody.method="fmm"' --set nbody.fmm_order=4 \
+  "$examples/plummer.toml" --set particles.0.count=800 --set 'nbody.method="fmm"' --set nbody.fmm_order=4 \
   --set 'simulation.time_steps="block"' --set simulation.dt=0.0625 --set simulation.max_bin=8 --set simulation.eta=0.2 \
   --set 'output.format="hdf5"' --set output.interval=0.125
 

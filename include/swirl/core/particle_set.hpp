@@ -320,4 +320,11 @@ class ParticleSet {
   std::vector<IntField> int_extra_;
 };
 
+// Compiled once, in src/core/particle_set.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template struct Vec3Array<float>;
+extern template struct Vec3Array<double>;
+extern template class ParticleSet<float>;
+extern template class ParticleSet<double>;
+
 }  // namespace swirl

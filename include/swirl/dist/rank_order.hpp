@@ -326,4 +326,9 @@ class RankOrder {
   DistributeWorkspace<Real> distribute_work_;  // the sort's buffers, kept between steps
 };
 
+// Compiled once, in src/dist/rank_order.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class RankOrder<float>;
+extern template class RankOrder<double>;
+
 }  // namespace swirl::dist

@@ -170,4 +170,9 @@ void evaluate_alone(Solver<Real>& solver, ParticleSet<Real>& particles, std::siz
   evaluate_alone(solver, particles, order, block_size);
 }
 
+// Compiled once, in src/force/solver.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class Solver<float>;
+extern template class Solver<double>;
+
 }  // namespace swirl

@@ -249,4 +249,9 @@ class BlockStepper final : public Stepper<Real> {
   double sub_steps_ = 0, active_updates_ = 0, steps_ = 0;
 };
 
+// Compiled once, in src/integrate/block_steps.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class BlockStepper<float>;
+extern template class BlockStepper<double>;
+
 }  // namespace swirl::integrate

@@ -169,4 +169,9 @@ class KickDriftStepper final : public Stepper<Real> {
   std::vector<std::uint8_t> outside_before_;  // scratch of the box's pass two, one flag per particle
 };
 
+// Compiled once, in src/integrate/kick_drift.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class KickDriftStepper<float>;
+extern template class KickDriftStepper<double>;
+
 }  // namespace swirl::integrate

@@ -111,4 +111,9 @@ class Stepper {
   virtual void load_state(const NamedValues& /*values*/) {}
 };
 
+// Compiled once, in src/integrate/stepper.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class Stepper<float>;
+extern template class Stepper<double>;
+
 }  // namespace swirl::integrate

@@ -185,4 +185,9 @@ class InletsAndOutlets final : public Observer<Real> {
   std::uint64_t emitted_ = 0, removed_ = 0;
 };
 
+// Compiled once, in src/sim/inlets_outlets.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class InletsAndOutlets<float>;
+extern template class InletsAndOutlets<double>;
+
 }  // namespace swirl::sim

@@ -700,4 +700,9 @@ class Simulation {
   bool started_ = false;
 };
 
+// Compiled once, in src/sim/simulation.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class Simulation<float>;
+extern template class Simulation<double>;
+
 }  // namespace swirl

@@ -253,4 +253,9 @@ class SortedCellGrid {
   static constexpr std::uint64_t kMaxDenseKeys = std::uint64_t{1} << 31;
 };
 
+// Compiled once, in src/spatial/cell_grid.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class SortedCellGrid<float>;
+extern template class SortedCellGrid<double>;
+
 }  // namespace swirl::spatial

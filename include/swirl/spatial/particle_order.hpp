@@ -366,4 +366,9 @@ class ParticleOrder {
   ParticleReorder<Real> reorder_;
 };
 
+// Compiled once, in src/spatial/particle_order.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class ParticleOrder<float>;
+extern template class ParticleOrder<double>;
+
 }  // namespace swirl::spatial

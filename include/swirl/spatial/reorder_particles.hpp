@@ -98,4 +98,9 @@ class ParticleReorder {
   AlignedVector<std::uint64_t> ids_;
 };
 
+// Compiled once, in src/spatial/reorder_particles.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class ParticleReorder<float>;
+extern template class ParticleReorder<double>;
+
 }  // namespace swirl::spatial

@@ -262,4 +262,9 @@ class SpatialHash {
   std::vector<BlockList> block_lists_;  // kept between searches to avoid reallocation
 };
 
+// Compiled once, in src/spatial/spatial_hash.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class SpatialHash<float>;
+extern template class SpatialHash<double>;
+
 }  // namespace swirl::spatial

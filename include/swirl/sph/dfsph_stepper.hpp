@@ -406,4 +406,9 @@ class DfsphStepper final : public integrate::Stepper<Real> {
   bool refresh_ = false;
 };
 
+// Compiled once, in src/sph/dfsph_stepper.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class DfsphStepper<float>;
+extern template class DfsphStepper<double>;
+
 }  // namespace swirl::sph

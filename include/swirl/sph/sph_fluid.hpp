@@ -1209,4 +1209,9 @@ class SphFluid final : public Solver<Real> {
   std::uint64_t fluid_count_for_ = std::numeric_limits<std::uint64_t>::max();  // the ranks' particle count it was summed at
 };
 
+// Compiled once, in src/sph/sph_fluid.cpp: users link the float and double copies
+// instead of compiling them again.
+extern template class SphFluid<float>;
+extern template class SphFluid<double>;
+
 }  // namespace swirl::sph
