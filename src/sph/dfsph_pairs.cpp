@@ -2,7 +2,6 @@
 // to the copy of simd::active().
 #include "swirl/core/simd_dispatch.hpp"
 #include "swirl/sph/dfsph_pair_kernels.hpp"
-#include "swirl/sph/dfsph_pairs.hpp"
 
 namespace swirl::sph {
 
@@ -27,9 +26,5 @@ void dfsph_pressure_block_simd(const PackedParticles& p, const PairBlock& block,
   SWIRL_SIMD_DISPATCH(dfsph_pressure_block_simd, p, block, first, kind, k_over_rho, dt, vx, vy, vz);
 }
 bool dfsph_pairs_simd_fuses() { SWIRL_SIMD_DISPATCH(dfsph_pairs_simd_fuses); }
-
-// The float and double DfsphPairs, declared extern in the header.
-template class DfsphPairs<float>;
-template class DfsphPairs<double>;
 
 }  // namespace swirl::sph

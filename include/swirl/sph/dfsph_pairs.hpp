@@ -358,9 +358,4 @@ void dfsph_pressure_velocity(DfsphPairs<Real>& pairs, ParticleSet<Real>& p, std:
   });
 }
 
-// Compiled once, in src/sph/dfsph_pairs.cpp: users link the float and double copies
-// instead of compiling them again.
-extern template class DfsphPairs<float>;
-extern template class DfsphPairs<double>;
-
 }  // namespace swirl::sph
